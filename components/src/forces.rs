@@ -1,0 +1,46 @@
+//! Per-contribution forces (house plan, section 2).
+//!
+//! Every force model writes its **own** component (`FieldForce`, `DipoleForce`, a user's
+//! `MyForce`, ...), each implementing [`ForceContribution`]. The `Accumulate` set then sums the
+//! registered contributions into [`NetForce`] / [`NetTorque`] in a fixed registration order, so
+//! the sum is bitwise reproducible and each contribution stays inspectable.
+
+use bevy_ecs::prelude::Component;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// A force (and torque) contribution component.
+///
+/// ```
+/// use bevy_ecs::prelude::Component;
+/// use glam::DVec3;
+/// use magsep_components::forces::ForceContribution;
+///
+/// /// Gravity on a particle [N].
+/// #[derive(Component, Default, Clone, Copy)]
+/// struct GravityForce(DVec3);
+/// impl ForceContribution for GravityForce {
+///     fn force(&self) -> DVec3 { self.0 }
+///     fn clear(&mut self) { self.0 = DVec3::ZERO; }
+/// }
+/// let g = GravityForce(DVec3::new(0.0, 0.0, -9.81));
+/// assert_eq!(g.torque(), DVec3::ZERO);
+/// ```
+pub trait ForceContribution: Component<Mutability = bevy_ecs::component::Mutable> + Default {
+    /// Force on the particle [N].
+    fn force(&self) -> DVec3;
+    /// Torque on the particle about its centre [N m]. Default: none.
+    fn torque(&self) -> DVec3 {
+        DVec3::ZERO
+    }
+    /// Reset to zero at the start of a step.
+    fn clear(&mut self);
+}
+
+/// Sum of all registered contributions [N].
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NetForce(pub DVec3);
+
+/// Sum of all registered torque contributions [N m].
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NetTorque(pub DVec3);

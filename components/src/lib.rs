@@ -1,0 +1,32 @@
+//! # magsep-components
+//!
+//! Data only: ECS components, resources and validated newtypes shared by every magsep crate.
+//! No systems and no I/O live here (house plan, section 1). All quantities are SI unless a
+//! field's documentation says otherwise.
+//!
+//! ```
+//! use magsep_components::prelude::*;
+//! let shape = Shape::Spherocylinder { radius: 0.5, half_length: 2.0 };
+//! assert_eq!(shape.radius(), 0.5);
+//! ```
+
+pub mod clock;
+pub mod container;
+pub mod forces;
+pub mod health;
+pub mod packing;
+pub mod particle;
+pub mod shape;
+
+/// Everything a user usually needs, in one import.
+pub mod prelude {
+    pub use crate::clock::StepClock;
+    pub use crate::container::Container;
+    pub use crate::forces::{ForceContribution, NetForce, NetTorque};
+    pub use crate::health::Health;
+    pub use crate::packing::{
+        OverlapRemovalScheme, PackingConfig, PackingStatus, StopReason, VolumeStepRule,
+    };
+    pub use crate::particle::{Orientation, ParticleBundle, ParticleId, ParticleRng, Position, Species};
+    pub use crate::shape::Shape;
+}

@@ -1,0 +1,49 @@
+//! Data exchanged with recordings: one frame of particle state, and the run's metadata.
+//! Lengths in metres, time in seconds.
+
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Lossless state of all particles at one step (the `/state` channel). Arrays are in
+/// `ParticleId` order and all have one entry per particle.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ParticleFrame {
+    /// Schedule step (a compression step for packing).
+    pub step: u64,
+    /// Simulated time = step * dt [s] (0 for packing).
+    pub time: f64,
+    /// Edges of the periodic box [m].
+    pub box_edges: DVec3,
+    /// `ParticleId`s.
+    pub ids: Vec<u64>,
+    /// Centres [m].
+    pub positions: Vec<DVec3>,
+    /// Orientations (body z = symmetry axis).
+    pub orientations: Vec<DQuat>,
+    /// Radii R [m].
+    pub radii: Vec<f64>,
+    /// Half lengths of the axis segment [m] (0 for spheres).
+    pub half_lengths: Vec<f64>,
+    /// Per-particle xoshiro256++ state words (for bitwise resume).
+    pub rng_states: Vec<[u64; 4]>,
+    /// Pipeline status (counters, step sizes, RNG of the driver) as a JSON object.
+    pub status_json: String,
+}
+
+/// Metadata written once at the start of a recording (MCAP metadata record `magsep`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RecordingMetadata {
+    /// The scene file's text, verbatim.
+    pub scene_text: String,
+    /// Seed of the run.
+    pub seed: u64,
+    /// magsep version that wrote the file.
+    pub version: String,
+    /// Pipeline name (`packing`, ...).
+    pub pipeline: String,
+    /// Resolved schedule: set name -> system names, in run order.
+    pub schedule: BTreeMap<String, Vec<String>>,
+    /// Time step [s] (0 for packing).
+    pub dt: f64,
+}

@@ -1,0 +1,291 @@
+//! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame.
+
+use super::proto::{ParticleState, particle_count, state_schema};
+use super::scene::scene_update;
+use super::{
+    METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
+    SUMMARY_METADATA_NAME,
+};
+use foxglove::Encode;
+use foxglove::messages::SceneUpdate;
+use mcap::records::{MessageHeader, Metadata};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+type McapWriter = mcap::Writer<BufWriter<File>>;
+
+// The writer lives in a bevy_ecs `Resource`, which must be `Send + Sync`. With mcap's
+// zstd-only build `mcap::Writer<BufWriter<File>>` is both; fail the build if that changes.
+const _: fn() = || {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<McapWriter>();
+    assert_send_sync::<RecordingWriter>();
+};
+
+/// MCAP log time [ns] of `frame`: `frame.step` when `frame.time == 0.0` (packing has no
+/// physical time, so steps serve as the clock), else `round(frame.time * 1e9)` (negative or
+/// NaN times give 0, times beyond `u64::MAX` ns saturate).
+///
+/// [`RecordingWriter::write_frame`] additionally clamps each log time to be at least the
+/// previous one, so log times never decrease within a recording.
+pub fn log_time_ns(frame: &ParticleFrame) -> u64 {
+    if frame.time == 0.0 {
+        frame.step
+    } else {
+        // `as` saturates (and maps NaN to 0), which is the intent here.
+        (frame.time * 1e9).round() as u64
+    }
+}
+
+/// Writes a recording: MCAP with zstd-compressed chunks, channels [`STATE_TOPIC`] and
+/// [`SCENE_TOPIC`], metadata records [`METADATA_NAME`] and [`SUMMARY_METADATA_NAME`].
+///
+/// Every call that writes data ends the current chunk and flushes the file, so a process killed
+/// at any point leaves a file whose finished frames [`read_recording`](super::read_recording)
+/// recovers. [`finish`](Self::finish) writes the summary section and footer; dropping an
+/// unfinished writer does the same on a best-effort basis (errors are ignored, nothing panics).
+///
+/// The writer is `Send + Sync` (checked at compile time) so that it can live in a bevy_ecs
+/// `Resource`.
+pub struct RecordingWriter {
+    /// `None` only once finished.
+    mcap: Option<McapWriter>,
+    path: PathBuf,
+    state_channel: u16,
+    scene_channel: u16,
+    frames_written: u64,
+    last_log_time: Option<u64>,
+    /// Reused message encoding buffer.
+    buf: Vec<u8>,
+}
+
+impl RecordingWriter {
+    /// Creates (or truncates) the file at `path`, writes the MCAP header, the schemas and
+    /// channels, and the metadata record [`METADATA_NAME`] with keys `scene_text` (verbatim),
+    /// `seed` (decimal), `version`, `pipeline`, `dt` (seconds, shortest round-trip decimal) and
+    /// `schedule` (JSON object: set name -> system names), then flushes the file.
+    pub fn create(path: &Path, meta: &RecordingMetadata) -> Result<Self, RecordError> {
+        let file = File::create(path).map_err(|source| RecordError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .library(format!("magsep-plugins/{}", env!("CARGO_PKG_VERSION")))
+            // Chunks end at every flush, i.e. once per frame.
+            .chunk_size(None);
+        let mut writer = Self {
+            mcap: None,
+            path: path.to_path_buf(),
+            state_channel: 0,
+            scene_channel: 0,
+            frames_written: 0,
+            last_log_time: None,
+            buf: Vec::new(),
+        };
+        let mut mcap = options
+            .create(BufWriter::new(file))
+            .map_err(|e| writer.write_error(e))?;
+
+        let (name, encoding, data) = state_schema()?;
+        let state_schema = mcap
+            .add_schema(&name, &encoding, &data)
+            .map_err(|e| writer.write_error(e))?;
+        let scene =
+            <SceneUpdate as Encode>::get_schema().ok_or_else(|| RecordError::InvalidInput {
+                detail: "foxglove provides no schema for SceneUpdate".into(),
+            })?;
+        let scene_schema = mcap
+            .add_schema(&scene.name, &scene.encoding, &scene.data)
+            .map_err(|e| writer.write_error(e))?;
+        let no_meta = BTreeMap::new();
+        let encoding = <SceneUpdate as Encode>::get_message_encoding();
+        writer.state_channel = mcap
+            .add_channel(state_schema, STATE_TOPIC, &encoding, &no_meta)
+            .map_err(|e| writer.write_error(e))?;
+        writer.scene_channel = mcap
+            .add_channel(scene_schema, SCENE_TOPIC, &encoding, &no_meta)
+            .map_err(|e| writer.write_error(e))?;
+        writer.mcap = Some(mcap);
+
+        let schedule =
+            serde_json::to_string(&meta.schedule).map_err(|e| RecordError::InvalidInput {
+                detail: format!("schedule is not serialisable as JSON: {e}"),
+            })?;
+        let entries = [
+            ("scene_text", meta.scene_text.clone()),
+            ("seed", meta.seed.to_string()),
+            ("version", meta.version.clone()),
+            ("pipeline", meta.pipeline.clone()),
+            ("dt", format!("{:?}", meta.dt)),
+            ("schedule", schedule),
+        ];
+        writer.write_metadata(METADATA_NAME, &entries)?;
+        Ok(writer)
+    }
+
+    /// The file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Number of frames written so far.
+    pub fn frames_written(&self) -> u64 {
+        self.frames_written
+    }
+
+    /// Writes `frame` as one message on [`STATE_TOPIC`] and one on [`SCENE_TOPIC`], both with log
+    /// and publish time [`log_time_ns`] (clamped to be non-decreasing), then ends the chunk and
+    /// flushes the file.
+    ///
+    /// `colours` gives each particle's RGBA colour (components in 0..1) in the scene, in the
+    /// frame's particle order; `None` uses a default colour. Fails with
+    /// [`RecordError::InvalidInput`] if the frame's arrays (or `colours`) differ in length.
+    pub fn write_frame(
+        &mut self,
+        frame: &ParticleFrame,
+        colours: Option<&[[f32; 4]]>,
+    ) -> Result<(), RecordError> {
+        let n = particle_count(frame)?;
+        if let Some(c) = colours
+            && c.len() != n
+        {
+            return Err(RecordError::InvalidInput {
+                detail: format!(
+                    "frame at step {}: {} colours for {n} particles",
+                    frame.step,
+                    c.len()
+                ),
+            });
+        }
+        let log_time = log_time_ns(frame).max(self.last_log_time.unwrap_or(0));
+        // MCAP sequence numbers are u32; wrapping after 2^32 frames is harmless.
+        let sequence = self.frames_written as u32;
+
+        self.buf.clear();
+        ParticleState::from_frame(frame)
+            .encode(&mut self.buf)
+            .map_err(|e| RecordError::InvalidInput {
+                detail: format!("encoding /state: {e}"),
+            })?;
+        self.write_message(self.state_channel, sequence, log_time)?;
+
+        self.buf.clear();
+        scene_update(frame, colours, log_time)
+            .encode(&mut self.buf)
+            .map_err(|e| RecordError::InvalidInput {
+                detail: format!("encoding /scene: {e}"),
+            })?;
+        self.write_message(self.scene_channel, sequence, log_time)?;
+
+        self.flush()?;
+        self.last_log_time = Some(log_time);
+        self.frames_written += 1;
+        Ok(())
+    }
+
+    /// Writes the metadata record [`SUMMARY_METADATA_NAME`] with key `summary` = `summary_json`
+    /// (which must be valid JSON, normally an object), then flushes. May be called more than
+    /// once; readers keep the last one.
+    pub fn write_summary(&mut self, summary_json: &str) -> Result<(), RecordError> {
+        serde_json::from_str::<serde_json::Value>(summary_json).map_err(|e| {
+            RecordError::InvalidInput {
+                detail: format!("summary is not valid JSON: {e}"),
+            }
+        })?;
+        self.write_metadata(SUMMARY_METADATA_NAME, &[("summary", summary_json.into())])
+    }
+
+    /// Writes the summary section (schemas, channels, statistics, indexes) and the footer,
+    /// flushes and syncs the file to disk.
+    pub fn finish(mut self) -> Result<(), RecordError> {
+        let Some(mut mcap) = self.mcap.take() else {
+            return Ok(());
+        };
+        mcap.finish().map_err(|e| self.write_error(e))?;
+        let file = mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| self.io_error(e.into_error()))?;
+        file.sync_all().map_err(|e| self.io_error(e))
+    }
+
+    fn mcap(&mut self) -> &mut McapWriter {
+        self.mcap
+            .as_mut()
+            .expect("RecordingWriter holds its MCAP writer until finish() consumes it")
+    }
+
+    fn write_message(&mut self, channel: u16, sequence: u32, time: u64) -> Result<(), RecordError> {
+        let header = MessageHeader {
+            channel_id: channel,
+            sequence,
+            log_time: time,
+            publish_time: time,
+        };
+        let buf = std::mem::take(&mut self.buf);
+        let result = self.mcap().write_to_known_channel(&header, &buf);
+        self.buf = buf;
+        result.map_err(|e| self.write_error(e))
+    }
+
+    fn write_metadata(
+        &mut self,
+        name: &str,
+        entries: &[(&str, String)],
+    ) -> Result<(), RecordError> {
+        let metadata = Metadata {
+            name: name.into(),
+            metadata: entries
+                .iter()
+                .map(|(k, v)| ((*k).to_string(), v.clone()))
+                .collect(),
+        };
+        let result = self.mcap().write_metadata(&metadata);
+        result.map_err(|e| self.write_error(e))?;
+        self.flush()
+    }
+
+    /// Ends the current chunk and flushes the `BufWriter` to the file (see `mcap::Writer::flush`).
+    fn flush(&mut self) -> Result<(), RecordError> {
+        let result = self.mcap().flush();
+        result.map_err(|e| self.write_error(e))
+    }
+
+    fn write_error(&self, source: mcap::McapError) -> RecordError {
+        RecordError::Write {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    fn io_error(&self, source: std::io::Error) -> RecordError {
+        RecordError::Io {
+            path: self.path.clone(),
+            source,
+        }
+    }
+}
+
+impl Drop for RecordingWriter {
+    /// Finishes the file best-effort if [`finish`](Self::finish) was not called; errors are
+    /// ignored and nothing panics (the underlying `mcap::Writer` also finishes on drop).
+    fn drop(&mut self) {
+        if let Some(mut mcap) = self.mcap.take() {
+            let _ = mcap.finish();
+            // Dropping the BufWriter flushes it, ignoring errors.
+        }
+    }
+}
+
+impl std::fmt::Debug for RecordingWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RecordingWriter")
+            .field("path", &self.path)
+            .field("frames_written", &self.frames_written)
+            .field("finished", &self.mcap.is_none())
+            .finish()
+    }
+}

@@ -1,0 +1,7 @@
+//! Characterisation of packings: contact numbers, orientational order, pair correlation.
+
+pub mod contacts;
+pub mod order;
+
+pub use contacts::{ContactNumbers, contact_numbers};
+pub use order::{nematic_order, symmetric_eigenvalues};

@@ -1,0 +1,33 @@
+//! # magsep-systems
+//!
+//! Pure kernels (plain functions on `f64`/`DVec3`, no `World`) and the thin ECS systems that
+//! call them, plus the schedule labels and sets (house plan, sections 1-2).
+//!
+//! * [`sets`]: [`sets::SimSchedule`], the chained [`sets::SimSystems`] and [`sets::ForceSystems`].
+//! * [`forces`]: fixed-order accumulation of per-contribution force components.
+//! * [`geometry`]: volumes, inertia, segment distances.
+//! * [`packing`]: the mechanical contraction method.
+//! * [`analysis`]: contact numbers and order parameters.
+//! * [`rng`]: per-particle random streams.
+
+pub mod analysis;
+pub mod clock;
+pub mod forces;
+pub mod geometry;
+pub mod packing;
+pub mod rng;
+pub mod sets;
+
+use bevy_ecs::prelude::Resource;
+
+/// Seed of the run (a resource).
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunSeed(pub u64);
+
+/// Errors of the systems crate.
+#[derive(Debug, thiserror::Error)]
+pub enum SystemsError {
+    /// Random insertion could not place a particle.
+    #[error(transparent)]
+    Insertion(#[from] packing::insert::InsertionError),
+}

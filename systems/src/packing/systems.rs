@@ -1,0 +1,208 @@
+//! ECS glue of the MCM: thin systems around the dense kernels.
+//!
+//! | set | system | reads / writes |
+//! |---|---|---|
+//! | Prepare | [`begin_compression_step`] | `McmWorkspace`, `PackingStatus` |
+//! | Constraints | [`remove_overlaps_mcm`] | `McmWorkspace` |
+//! | Finalize | [`settle_compression_step`] -> [`write_back_particles`] | `McmWorkspace`, `PackingStatus`, `Position`, `Orientation`, `Container` |
+//! | Observe | [`observe_packing`] | `Position`, `Orientation`, `Shape`, `ParticleId`, `Container` -> `PackingObservables` |
+
+use bevy_ecs::prelude::*;
+use glam::{DQuat, DVec3};
+use magsep_components::prelude::*;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::compress::{DriverParams, compress, next_volume_step, settle_step};
+use super::neighbour::NeighbourList;
+use super::removal::{RemovalOutcome, remove_overlaps};
+use super::state::PackingState;
+use crate::analysis::{contact_numbers, nematic_order};
+use crate::rng::{DRIVER_STREAM, particle_stream};
+
+/// Dense working copy of the packing, in reduced units; the source of truth within a step.
+#[derive(Resource, Debug, Clone)]
+pub struct McmWorkspace {
+    /// Driver parameters (reduced units).
+    pub params: DriverParams,
+    /// Current configuration.
+    pub state: PackingState,
+    /// Last overlap-free configuration (saved in `Prepare`).
+    pub saved: Option<PackingState>,
+    /// Verlet list.
+    pub list: NeighbourList,
+    /// Driver random stream (sweep order).
+    pub rng: Xoshiro256PlusPlus,
+    /// Reference diameter D [m] of the reduced units.
+    pub reference_diameter: f64,
+    /// Particle entities in `ParticleId` order.
+    pub entities: Vec<Entity>,
+    /// Volume step of the current step / D^3.
+    pub current_volume_step: f64,
+    /// Outcome of the current step's overlap removal.
+    pub outcome: Option<RemovalOutcome>,
+}
+
+/// Skin of the MCM Verlet list / D.
+pub const MCM_SKIN: f64 = 0.3;
+
+/// Build the workspace from the spawned particles (exclusive; call once after spawning).
+pub fn init_mcm_workspace(world: &mut World) {
+    let config = *world.resource::<PackingConfig>();
+    let seed = world.get_resource::<crate::RunSeed>().map(|s| s.0).unwrap_or(0);
+    let edge = world.resource::<Container>().edges().x;
+    let mut q = world.query::<(Entity, &ParticleId, &Position, &Orientation, &Shape)>();
+    let mut rows: Vec<_> = q.iter(world).map(|(e, id, p, o, s)| (*id, e, p.0, o.0, *s)).collect();
+    rows.sort_by_key(|r| r.0);
+    let d = reference_diameter(rows.iter().map(|r| &r.4));
+    let positions: Vec<DVec3> = rows.iter().map(|r| r.2).collect();
+    let orientations: Vec<DQuat> = rows.iter().map(|r| r.3).collect();
+    let shapes: Vec<Shape> = rows.iter().map(|r| r.4).collect();
+    let state = PackingState::from_si(edge, &positions, &orientations, &shapes, d);
+    let params = DriverParams::from_config(&config, d);
+    let mut status = super::compress::initial_status(&params, &state);
+    if let Some(old) = world.get_resource::<PackingStatus>() {
+        // resuming: keep counters and step sizes
+        status = *old;
+    }
+    world.insert_resource(status);
+    world.insert_resource(McmWorkspace {
+        params,
+        state,
+        saved: None,
+        list: NeighbourList::new(MCM_SKIN),
+        rng: world.get_resource::<DriverRng>().map(|r| r.0.clone()).unwrap_or_else(|| particle_stream(seed, DRIVER_STREAM)),
+        reference_diameter: d,
+        entities: rows.iter().map(|r| r.1).collect(),
+        current_volume_step: 0.0,
+        outcome: None,
+    });
+    world.init_resource::<PackingObservables>();
+}
+
+/// The driver's random stream when restored from a recording.
+#[derive(Resource, Debug, Clone)]
+pub struct DriverRng(pub Xoshiro256PlusPlus);
+
+/// The reference diameter of a set of shapes: the smallest particle diameter 2R [m].
+pub fn reference_diameter<'a>(shapes: impl Iterator<Item = &'a Shape>) -> f64 {
+    let d = shapes.map(|s| 2.0 * s.radius()).fold(f64::INFINITY, f64::min);
+    if d.is_finite() { d } else { 1.0 }
+}
+
+/// Prepare: save the overlap-free state and compress the box.
+pub fn begin_compression_step(mut ws: ResMut<McmWorkspace>, status: Res<PackingStatus>) {
+    if status.stopped.is_some() {
+        return;
+    }
+    let ws = &mut *ws;
+    ws.saved = Some(ws.state.clone());
+    let dv = next_volume_step(&ws.params, &status, &ws.state);
+    ws.current_volume_step = dv;
+    compress(&mut ws.state, &mut ws.list, dv);
+}
+
+/// Constraints: remove overlaps within the attempt budget.
+pub fn remove_overlaps_mcm(mut ws: ResMut<McmWorkspace>, status: Res<PackingStatus>) {
+    if status.stopped.is_some() {
+        return;
+    }
+    let ws = &mut *ws;
+    let p = ws.params;
+    ws.outcome = Some(remove_overlaps(&mut ws.state, &mut ws.list, p.rule, p.tolerance, p.max_attempts, &mut ws.rng));
+}
+
+/// Finalize: accept the step, or revert and refine it; decide whether the run ends.
+pub fn settle_compression_step(mut ws: ResMut<McmWorkspace>, mut status: ResMut<PackingStatus>) {
+    let Some(out) = ws.outcome.take() else {
+        return;
+    };
+    let ws = &mut *ws;
+    let p = ws.params;
+    let dv = ws.current_volume_step;
+    let saved = ws.saved.take();
+    let (state, list) = (&mut ws.state, &mut ws.list);
+    settle_step(&p, &mut status, dv, out, || {
+        if let Some(s) = saved {
+            *state = s;
+            list.invalidate();
+        }
+    });
+    status.packing_fraction = ws.state.packing_fraction();
+}
+
+/// Finalize: copy the dense state back to the entities and the container (SI units).
+pub fn write_back_particles(
+    ws: Res<McmWorkspace>,
+    mut container: ResMut<Container>,
+    mut q: Query<(&mut Position, &mut Orientation)>,
+) {
+    let d = ws.reference_diameter;
+    let mut wrapped = ws.state.clone();
+    wrapped.wrap_all();
+    let (edge, positions) = wrapped.to_si(d);
+    *container = Container::PeriodicBox { edges: DVec3::splat(edge) };
+    for (k, e) in ws.entities.iter().enumerate() {
+        if let Ok((mut p, mut o)) = q.get_mut(*e) {
+            p.0 = positions[k];
+            o.0 = ws.state.orientations[k];
+        }
+    }
+}
+
+/// Measured properties of the current packing (a resource).
+#[derive(Resource, Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PackingObservables {
+    /// Step at which they were computed.
+    pub step: u64,
+    /// Packing fraction.
+    pub packing_fraction: f64,
+    /// Mean contact number extrapolated to delta -> 0.
+    pub mean_contact_number: f64,
+    /// Mean contact number at delta = 1e-4 D.
+    pub mean_contact_number_1e_4: f64,
+    /// Nematic order S.
+    pub nematic_order: f64,
+    /// Largest remaining overlap / D.
+    pub max_overlap: f64,
+    /// Contact-number histogram (index = number of contacts).
+    pub contact_histogram: Vec<u64>,
+    /// Whether they were ever computed.
+    pub computed: bool,
+}
+
+/// Whether [`observe_packing`] runs this step: at the end of the run, and every
+/// `observe_every` steps.
+pub fn should_observe(clock: Res<StepClock>, status: Option<Res<PackingStatus>>, config: Option<Res<PackingConfig>>) -> bool {
+    let end = status.map(|s| s.stopped.is_some()).unwrap_or(true);
+    let every = config.map(|c| c.observe_every).unwrap_or(0);
+    end || (every > 0 && clock.step % every == 0)
+}
+
+/// Observe: packing fraction, extrapolated contact number and nematic order, from the
+/// entities (so it runs unchanged on replayed frames).
+pub fn observe_packing(
+    clock: Res<StepClock>,
+    container: Res<Container>,
+    q: Query<(&ParticleId, &Position, &Orientation, &Shape)>,
+    mut obs: ResMut<PackingObservables>,
+) {
+    let mut rows: Vec<_> = q.iter().map(|(id, p, o, s)| (*id, p.0, o.0, *s)).collect();
+    rows.sort_by_key(|r| r.0);
+    let shapes: Vec<Shape> = rows.iter().map(|r| r.3).collect();
+    let d = reference_diameter(shapes.iter());
+    let positions: Vec<DVec3> = rows.iter().map(|r| r.1).collect();
+    let orientations: Vec<DQuat> = rows.iter().map(|r| r.2).collect();
+    let state = PackingState::from_si(container.edges().x, &positions, &orientations, &shapes, d);
+    let cn = contact_numbers(&state);
+    let rod_axes: Vec<DVec3> = (0..state.len()).filter(|&i| state.bodies[i].half_length > 0.0).map(|i| state.axis(i)).collect();
+    *obs = PackingObservables {
+        step: clock.step,
+        packing_fraction: state.packing_fraction(),
+        mean_contact_number: cn.extrapolated,
+        mean_contact_number_1e_4: cn.at_1e_4,
+        nematic_order: nematic_order(&rod_axes),
+        max_overlap: cn.max_overlap,
+        contact_histogram: cn.histogram,
+        computed: true,
+    };
+}
