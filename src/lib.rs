@@ -1,1 +1,39 @@
+//! # magsep
+//!
+//! Particles in magnetic separation: random fibre packings by mechanical contraction, exact
+//! fields of magnetised fibres, Brownian capture, density separation. This crate is the facade:
+//! the [`prelude`], scene loading ([`scene`]), the [`Simulation`] builder, summaries, replay,
+//! charts and the `magsep` CLI.
+//!
+//! ```no_run
+//! use magsep::prelude::*;
+//! let summary = magsep::sim::run_scene_file("scenes/spheres_500.toml".as_ref(), RunOptions::default()).unwrap();
+//! println!("{}", summary["packing_fraction"]);
+//! ```
 
+pub mod chart;
+pub mod replay;
+pub mod scene;
+pub mod sim;
+pub mod summary;
+
+pub use sim::{RunOptions, SimError, Simulation};
+
+/// Everything a user usually needs.
+pub mod prelude {
+    pub use crate::sim::{RunOptions, SimError, Simulation};
+    pub use magsep_components::prelude::*;
+    pub use magsep_plugins::app::{SimApp, SimPlugin};
+    pub use magsep_plugins::core::{CorePlugin, FinalizeSystems};
+    pub use magsep_plugins::group::PipelineGroup;
+    pub use magsep_plugins::packing::{
+        McmCompressionPlugin, McmOverlapRemovalPlugin, PackingObservePlugin, packing_pipeline,
+    };
+    pub use magsep_plugins::recorder::RecordPlugin;
+    pub use magsep_systems::sets::{ForceSystems, ObserveSchedule, SimSchedule, SimSystems};
+}
+
+/// The crates underneath, re-exported.
+pub use magsep_components as components;
+pub use magsep_plugins as plugins;
+pub use magsep_systems as systems;

@@ -1,2 +1,20 @@
-pub fn x(){}
+//! # magsep-plugins
+//!
+//! Plugin wiring over the simulation schedule (which system runs in which set), the pipelines
+//! as plugin groups, and MCAP record/replay.
+//!
+//! * [`app`]: [`app::SimApp`] and the [`app::SimPlugin`] trait.
+//! * [`group`]: [`group::PipelineGroup`]: add, disable, replace plugins.
+//! * [`core`]: clock and health.
+//! * [`packing`]: the `packing` pipeline.
+//! * [`recorder`] and [`record`]: recordings.
+
+pub mod app;
+pub mod core;
+pub mod group;
+pub mod packing;
 pub mod record;
+pub mod recorder;
+
+pub use app::{SimApp, SimPlugin};
+pub use group::PipelineGroup;

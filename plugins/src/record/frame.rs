@@ -11,19 +11,19 @@ use std::collections::BTreeMap;
 pub struct ParticleFrame {
     /// Schedule step (a compression step for packing).
     pub step: u64,
-    /// Simulated time = step * dt [s] (0 for packing).
+    /// Simulated time = step * dt \[s\] (0 for packing).
     pub time: f64,
-    /// Edges of the periodic box [m].
+    /// Edges of the periodic box \[m\].
     pub box_edges: DVec3,
     /// `ParticleId`s.
     pub ids: Vec<u64>,
-    /// Centres [m].
+    /// Centres \[m\].
     pub positions: Vec<DVec3>,
     /// Orientations (body z = symmetry axis).
     pub orientations: Vec<DQuat>,
-    /// Radii R [m].
+    /// Radii R \[m\].
     pub radii: Vec<f64>,
-    /// Half lengths of the axis segment [m] (0 for spheres).
+    /// Half lengths of the axis segment \[m\] (0 for spheres).
     pub half_lengths: Vec<f64>,
     /// Per-particle xoshiro256++ state words (for bitwise resume).
     pub rng_states: Vec<[u64; 4]>,
@@ -44,6 +44,6 @@ pub struct RecordingMetadata {
     pub pipeline: String,
     /// Resolved schedule: set name -> system names, in run order.
     pub schedule: BTreeMap<String, Vec<String>>,
-    /// Time step [s] (0 for packing).
+    /// Time step \[s\] (0 for packing).
     pub dt: f64,
 }

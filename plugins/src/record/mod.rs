@@ -63,13 +63,15 @@
 
 #![warn(missing_docs)]
 
-mod bytes_io;
 pub mod frame;
+mod parse;
 mod proto;
 pub mod reader;
 mod scene;
 pub mod writer;
 
+#[cfg(test)]
+mod damage_tests;
 #[cfg(test)]
 mod tests;
 

@@ -5,7 +5,7 @@
 //! are used only once the chunk has decompressed and passed its CRC. The data-section and
 //! summary CRCs are checked when the file has them.
 
-use super::bytes_io::{Cursor, crc32, hex_prefix};
+use super::parse::{Cursor, check_chunk_header, crc32, hex_prefix, parse_metadata};
 use super::proto::ParticleStateWire;
 use super::{
     METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, STATE_TOPIC,
@@ -44,7 +44,7 @@ pub struct Recording {
     /// before its footer (process killed; the message gives the byte where the file ends and
     /// the start of the incomplete record), or a damaged record follows the frames read.
     pub truncated: Option<String>,
-    /// Size of the file [bytes].
+    /// Size of the file (bytes).
     pub file_bytes: u64,
 }
 
@@ -96,12 +96,8 @@ pub fn read_recording_bytes(data: &[u8]) -> Result<Recording, RecordError> {
     })
 }
 
-/// Records longer than this are taken as damaged rather than cut short [bytes].
+/// Records longer than this are taken as damaged rather than cut short (bytes).
 const MAX_RECORD_LEN: u64 = 1 << 40;
-/// Largest chunk accepted [bytes, uncompressed].
-const MAX_CHUNK_LEN: u64 = 1 << 36;
-/// Bound on zstd's expansion ratio (an RLE block turns 4 bytes into at most 128 KiB).
-const MAX_ZSTD_RATIO: u64 = 1 << 16;
 
 /// Why reading stopped before the footer.
 enum Stop {
@@ -164,7 +160,7 @@ struct Walk {
 impl Walk {
     fn truncated(&self, len: usize, what: String) -> Stop {
         Stop::Truncated(format!(
-            "file ends at byte {len} {what} (no footer): {} complete frames read",
+            "file ends at byte {len} {what}: {} complete frames read",
             self.frames.len()
         ))
     }
@@ -173,7 +169,7 @@ impl Walk {
         let len = data.len();
         let magic = mcap::MAGIC;
         if len < magic.len() && magic.starts_with(data) {
-            return Err(self.truncated(len, "inside the 8-byte MCAP magic".into()));
+            return Err(self.truncated(len, "inside the 8-byte MCAP magic (no footer)".into()));
         }
         if !data.starts_with(magic) {
             return Err(Stop::Failed(RecordError::NotMcap {
@@ -192,11 +188,14 @@ impl Walk {
             let start = pos;
             if len - pos < 9 {
                 let what = if pos == len && in_summary {
-                    "after a complete record of the summary section, before the footer".into()
+                    "after a complete record of the summary section (no footer)".into()
                 } else if pos == len {
-                    "after a complete record, before the summary and footer".into()
+                    "after a complete record, before the summary section (no footer)".into()
                 } else {
-                    format!("inside the opcode and length of a record that starts at byte {pos}")
+                    format!(
+                        "inside the opcode and length of a record that starts at byte {pos} \
+                         (no footer)"
+                    )
                 };
                 return Err(self.truncated(len, what));
             }
@@ -232,7 +231,7 @@ impl Walk {
                         format!(
                             "inside a chunk record that starts at byte {start} and was never \
                              completed (its length is still the writer's placeholder: the \
-                             writing process stopped in the middle of a frame)"
+                             writing process stopped in the middle of a frame; no footer)"
                         ),
                     ));
                 }
@@ -249,7 +248,7 @@ impl Walk {
                     len,
                     format!(
                         "inside a {k} record that starts at byte {start} and \
-                         declares {rlen} bytes"
+                         declares {rlen} bytes (no footer)"
                     ),
                 ));
             }
@@ -329,7 +328,10 @@ impl Walk {
         if tail.len() < magic.len() && magic.starts_with(tail) {
             return Err(self.truncated(
                 data.len(),
-                format!("inside the closing magic after the footer at byte {start}"),
+                format!(
+                    "inside the closing magic after the footer at byte {start} \
+                     (all records present)"
+                ),
             ));
         }
         if !tail.starts_with(magic) {
@@ -485,70 +487,4 @@ impl RecErr {
             RecErr::Decode(e) => decode_err(format!("{at}: {e}")),
         }
     }
-}
-
-/// Checks a chunk header for plausibility; returns the record length limit for decompression.
-fn check_chunk_header(body: &[u8]) -> Result<usize, String> {
-    let mut c = Cursor::new(body);
-    c.u64("message start time")?;
-    c.u64("message end time")?;
-    let uncompressed = c.u64("uncompressed size")?;
-    c.u32("uncompressed CRC")?;
-    let compression = c.string("compression")?;
-    let compressed = c.u64("compressed size")?;
-    let data_len = c.rest().len() as u64;
-    if compressed > data_len {
-        return Err(format!(
-            "compressed size {compressed} exceeds the {data_len} data bytes in the record"
-        ));
-    }
-    match compression.as_str() {
-        "zstd" => {
-            if uncompressed > compressed.saturating_mul(MAX_ZSTD_RATIO)
-                || uncompressed > MAX_CHUNK_LEN
-            {
-                return Err(format!(
-                    "uncompressed size {uncompressed} is impossible for {compressed} bytes of \
-                     zstd data (limit {MAX_CHUNK_LEN})"
-                ));
-            }
-        }
-        "" => {
-            if uncompressed != compressed || compressed != data_len {
-                return Err(format!(
-                    "uncompressed chunk with uncompressed size {uncompressed}, compressed size \
-                     {compressed} and {data_len} data bytes; expected all three equal"
-                ));
-            }
-        }
-        other => {
-            return Err(format!(
-                "compression {other:?} is not supported; expected \"zstd\" or \"\""
-            ));
-        }
-    }
-    let limit = uncompressed.max(compressed).max(4096);
-    usize::try_from(limit).map_err(|_| format!("chunk of {limit} bytes is too large"))
-}
-
-/// Parses the `magsep` metadata map (see `RecordingWriter::create`).
-fn parse_metadata(map: &BTreeMap<String, String>) -> Result<RecordingMetadata, String> {
-    let get = |key: &str| {
-        map.get(key)
-            .ok_or_else(|| format!("metadata {METADATA_NAME:?} lacks key {key:?}"))
-    };
-    let bad = |key: &str, value: &str, e: &dyn std::fmt::Display| {
-        format!("metadata {METADATA_NAME:?} key {key:?} has value {value:?}: {e}")
-    };
-    let seed = get("seed")?;
-    let dt = get("dt")?;
-    let schedule = get("schedule")?;
-    Ok(RecordingMetadata {
-        scene_text: get("scene_text")?.clone(),
-        seed: seed.parse().map_err(|e| bad("seed", seed, &e))?,
-        version: get("version")?.clone(),
-        pipeline: get("pipeline")?.clone(),
-        schedule: serde_json::from_str(schedule).map_err(|e| bad("schedule", schedule, &e))?,
-        dt: dt.parse().map_err(|e| bad("dt", dt, &e))?,
-    })
 }

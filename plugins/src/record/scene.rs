@@ -15,7 +15,7 @@ pub(crate) const BOX_ENTITY: &str = "box";
 pub(crate) const DEFAULT_COLOUR: [f32; 4] = [0.35, 0.55, 0.85, 1.0];
 /// Colour of the box edges (RGBA, 0..1).
 const BOX_COLOUR: [f64; 4] = [0.8, 0.8, 0.8, 1.0];
-/// Thickness of the box edges [screen pixels].
+/// Thickness of the box edges (screen pixels).
 const BOX_LINE_PX: f64 = 1.5;
 
 fn vec3(v: DVec3) -> Vector3 {

@@ -24,7 +24,7 @@ const _: fn() = || {
     assert_send_sync::<RecordingWriter>();
 };
 
-/// MCAP log time [ns] of `frame`: `frame.step` when `frame.time == 0.0` (packing has no
+/// MCAP log time (ns) of `frame`: `frame.step` when `frame.time == 0.0` (packing has no
 /// physical time, so steps serve as the clock), else `round(frame.time * 1e9)` (negative or
 /// NaN times give 0, times beyond `u64::MAX` ns saturate).
 ///

@@ -47,6 +47,7 @@ impl DriverParams {
     pub fn from_config(c: &PackingConfig, d: f64) -> Self {
         let rule = match c.scheme {
             magsep_components::packing::OverlapRemovalScheme::Revised => MoveRule::Revised { dt: c.revised_dt },
+            magsep_components::packing::OverlapRemovalScheme::Fire => MoveRule::Fire,
             magsep_components::packing::OverlapRemovalScheme::Original => {
                 MoveRule::Original { beta: c.original_beta, xi: c.original_xi.map(|x| x / (d * d)) }
             }
@@ -152,6 +153,17 @@ pub fn settle_step(p: &DriverParams, st: &mut PackingStatus, dv: f64, out: Remov
     }
 }
 
+/// Remove overlaps with the configured rule and budget.
+pub fn run_removal(p: &DriverParams, state: &mut PackingState, list: &mut NeighbourList, rng: &mut impl Rng) -> RemovalOutcome {
+    match p.rule {
+        MoveRule::Fire => {
+            let iterations = p.max_attempts / (state.len().max(1) as u64);
+            super::fire::remove_overlaps_fire(state, list, super::fire::FireParams::default(), p.tolerance, iterations.max(1))
+        }
+        rule => remove_overlaps(state, list, rule, p.tolerance, p.max_attempts, rng),
+    }
+}
+
 /// One full compression step (save, compress, remove, settle) on dense data.
 pub fn compression_step(
     p: &DriverParams,
@@ -166,7 +178,7 @@ pub fn compression_step(
     let saved = state.clone();
     let dv = next_volume_step(p, st, state);
     compress(state, list, dv);
-    let out = remove_overlaps(state, list, p.rule, p.tolerance, p.max_attempts, rng);
+    let out = run_removal(p, state, list, rng);
     settle_step(p, st, dv, out, || {
         *state = saved;
         list.invalidate();

@@ -36,7 +36,11 @@ pub struct PairContact {
 /// ```
 #[inline]
 pub fn pair_contact(u_i: DVec3, h_i: f64, r_i: f64, r: DVec3, u_j: DVec3, h_j: f64, r_j: f64) -> PairContact {
-    let c = segment_closest(u_i, h_i, r, u_j, h_j);
+    let c = if h_i == 0.0 && h_j == 0.0 {
+        crate::geometry::SegmentClosest { k: r, s: 0.0, t: 0.0 }
+    } else {
+        segment_closest(u_i, h_i, r, u_j, h_j)
+    };
     let d = c.k.length();
     let normal = if d > 1e-300 {
         c.k / d

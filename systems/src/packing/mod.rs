@@ -7,6 +7,7 @@
 
 pub mod compress;
 pub mod contact;
+pub mod fire;
 pub mod insert;
 pub mod moves;
 pub mod neighbour;

@@ -58,6 +58,9 @@ pub enum MoveRule {
         /// xi of eq. 2.6 / D^2.
         xi: Option<f64>,
     },
+    /// Collective FIRE minimisation of the overlap energy (see `fire`); not a
+    /// single-particle rule: [`overlap_removal_move`] returns None for it.
+    Fire,
     /// Fig. 3.4 variant (c): revised, random direction of w (same magnitude).
     RevisedRandomRotation {
         /// Delta t.
@@ -154,6 +157,7 @@ pub fn overlap_removal_move(
             };
             Some(Displacement { dx: v * scale, rotation })
         }
+        MoveRule::Fire => None,
         MoveRule::Original { beta, xi } => {
             let axis = orientation * DVec3::Z;
             let xi = xi.unwrap_or(body.xi_default);

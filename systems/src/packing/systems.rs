@@ -14,7 +14,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::compress::{DriverParams, compress, next_volume_step, settle_step};
 use super::neighbour::NeighbourList;
-use super::removal::{RemovalOutcome, remove_overlaps};
+use super::removal::RemovalOutcome;
 use super::state::PackingState;
 use crate::analysis::{contact_numbers, nematic_order};
 use crate::rng::{DRIVER_STREAM, particle_stream};
@@ -43,7 +43,7 @@ pub struct McmWorkspace {
 }
 
 /// Skin of the MCM Verlet list / D.
-pub const MCM_SKIN: f64 = 0.3;
+pub const MCM_SKIN: f64 = 0.1;
 
 /// Build the workspace from the spawned particles (exclusive; call once after spawning).
 pub fn init_mcm_workspace(world: &mut World) {
@@ -108,7 +108,7 @@ pub fn remove_overlaps_mcm(mut ws: ResMut<McmWorkspace>, status: Res<PackingStat
     }
     let ws = &mut *ws;
     let p = ws.params;
-    ws.outcome = Some(remove_overlaps(&mut ws.state, &mut ws.list, p.rule, p.tolerance, p.max_attempts, &mut ws.rng));
+    ws.outcome = Some(super::compress::run_removal(&p, &mut ws.state, &mut ws.list, &mut ws.rng));
 }
 
 /// Finalize: accept the step, or revert and refine it; decide whether the run ends.
@@ -162,7 +162,7 @@ pub struct PackingObservables {
     pub mean_contact_number_1e_4: f64,
     /// Nematic order S.
     pub nematic_order: f64,
-    /// Largest remaining overlap / D.
+    /// Largest remaining overlap [m].
     pub max_overlap: f64,
     /// Contact-number histogram (index = number of contacts).
     pub contact_histogram: Vec<u64>,
@@ -201,7 +201,7 @@ pub fn observe_packing(
         mean_contact_number: cn.extrapolated,
         mean_contact_number_1e_4: cn.at_1e_4,
         nematic_order: nematic_order(&rod_axes),
-        max_overlap: cn.max_overlap,
+        max_overlap: cn.max_overlap * d,
         contact_histogram: cn.histogram,
         computed: true,
     };

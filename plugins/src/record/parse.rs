@@ -1,9 +1,10 @@
-//! Bounds-checked parsing of MCAP record bodies, and CRC-32.
+//! Bounds-checked parsing of MCAP record bodies (chunk headers, metadata), and CRC-32.
 //!
 //! The reader parses records itself rather than through `mcap::parse_record`, whose string
 //! parsing reserves memory for a declared length before checking it against the data; here every
 //! length is checked against the bytes actually present first.
 
+use super::{METADATA_NAME, RecordingMetadata};
 use std::collections::BTreeMap;
 
 /// A cursor over one record body. Errors are human-readable descriptions.
@@ -81,6 +82,77 @@ impl<'a> Cursor<'a> {
         }
         Ok(map)
     }
+}
+
+/// Largest chunk accepted (bytes, uncompressed).
+const MAX_CHUNK_LEN: u64 = 1 << 36;
+/// Bound on zstd's expansion ratio (an RLE block turns 4 bytes into at most 128 KiB).
+const MAX_ZSTD_RATIO: u64 = 1 << 16;
+
+/// Checks a chunk header for plausibility; returns the record length limit for decompression.
+pub(crate) fn check_chunk_header(body: &[u8]) -> Result<usize, String> {
+    let mut c = Cursor::new(body);
+    c.u64("message start time")?;
+    c.u64("message end time")?;
+    let uncompressed = c.u64("uncompressed size")?;
+    c.u32("uncompressed CRC")?;
+    let compression = c.string("compression")?;
+    let compressed = c.u64("compressed size")?;
+    let data_len = c.rest().len() as u64;
+    if compressed > data_len {
+        return Err(format!(
+            "compressed size {compressed} exceeds the {data_len} data bytes in the record"
+        ));
+    }
+    match compression.as_str() {
+        "zstd" => {
+            if uncompressed > compressed.saturating_mul(MAX_ZSTD_RATIO)
+                || uncompressed > MAX_CHUNK_LEN
+            {
+                return Err(format!(
+                    "uncompressed size {uncompressed} is impossible for {compressed} bytes of \
+                     zstd data (limit {MAX_CHUNK_LEN})"
+                ));
+            }
+        }
+        "" => {
+            if uncompressed != compressed || compressed != data_len {
+                return Err(format!(
+                    "uncompressed chunk with uncompressed size {uncompressed}, compressed size \
+                     {compressed} and {data_len} data bytes; expected all three equal"
+                ));
+            }
+        }
+        other => {
+            return Err(format!(
+                "compression {other:?} is not supported; expected \"zstd\" or \"\""
+            ));
+        }
+    }
+    let limit = uncompressed.max(compressed).max(4096);
+    usize::try_from(limit).map_err(|_| format!("chunk of {limit} bytes is too large"))
+}
+
+/// Parses the `magsep` metadata map (see `RecordingWriter::create`).
+pub(crate) fn parse_metadata(map: &BTreeMap<String, String>) -> Result<RecordingMetadata, String> {
+    let get = |key: &str| {
+        map.get(key)
+            .ok_or_else(|| format!("metadata {METADATA_NAME:?} lacks key {key:?}"))
+    };
+    let bad = |key: &str, value: &str, e: &dyn std::fmt::Display| {
+        format!("metadata {METADATA_NAME:?} key {key:?} has value {value:?}: {e}")
+    };
+    let seed = get("seed")?;
+    let dt = get("dt")?;
+    let schedule = get("schedule")?;
+    Ok(RecordingMetadata {
+        scene_text: get("scene_text")?.clone(),
+        seed: seed.parse().map_err(|e| bad("seed", seed, &e))?,
+        version: get("version")?.clone(),
+        pipeline: get("pipeline")?.clone(),
+        schedule: serde_json::from_str(schedule).map_err(|e| bad("schedule", schedule, &e))?,
+        dt: dt.parse().map_err(|e| bad("dt", dt, &e))?,
+    })
 }
 
 const CRC_TABLE: [u32; 256] = {

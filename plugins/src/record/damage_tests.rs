@@ -1,0 +1,166 @@
+//! Tests of damaged recordings: killed writers, cut files, corrupt and fuzzed bytes.
+
+use super::tests::{
+    TempFile, assert_frames_bitwise_eq, bits, metadata, random_frames, write_recording,
+};
+use super::*;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use rand_xoshiro::rand_core::{Rng, SeedableRng};
+
+#[test]
+fn record_killed_writer_leaves_every_frame_readable() {
+    let frames = random_frames(21, 6, true);
+    let path = TempFile::new("killed.mcap");
+    let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
+    for f in &frames {
+        w.write_frame(f, None).unwrap();
+    }
+    // Simulate a kill: no finish, no drop, no buffered data written after the last flush.
+    std::mem::forget(w);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let rec = read_recording_bytes(&bytes).unwrap();
+    assert_frames_bitwise_eq(&rec.frames, &frames);
+    assert_eq!(rec.metadata, Some(metadata()));
+    let msg = rec.truncated.unwrap();
+    assert!(
+        msg.contains("after a complete record") && msg.contains("6 complete frames"),
+        "{msg}"
+    );
+
+    // Killed while a chunk was being written: its header still holds the placeholder length.
+    let start = bytes.len();
+    bytes.push(0x06);
+    bytes.extend_from_slice(&u64::MAX.to_le_bytes());
+    bytes.extend_from_slice(&[0; 30]);
+    let rec = read_recording_bytes(&bytes).unwrap();
+    assert_eq!(rec.frames.len(), 6);
+    let msg = rec.truncated.unwrap();
+    assert!(msg.contains(&format!("starts at byte {start}")) && msg.contains("placeholder"));
+}
+
+#[test]
+fn record_truncated_files_yield_a_prefix_of_frames() {
+    let frames = random_frames(99, 8, false);
+    let (_, bytes) = write_recording("cut.mcap", &frames, true);
+    let full = read_recording_bytes(&bytes).unwrap();
+    let mut last_count = 0;
+    let mut metadata_seen_at = None;
+    for cut in (0..bytes.len()).step_by(3).chain([1, 8, 10, 17]) {
+        let rec =
+            read_recording_bytes(&bytes[..cut]).unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
+        let msg = rec.truncated.as_ref().expect("a cut file is truncated");
+        assert!(msg.contains(&format!("file ends at byte {cut}")), "{msg}");
+        let n = rec.frames.len();
+        assert!(msg.contains(&format!("{n} complete frames read")), "{msg}");
+        assert_frames_bitwise_eq(&rec.frames, &frames[..n]);
+        if cut % 3 == 0 {
+            assert!(
+                n >= last_count,
+                "cut at {cut}: fewer frames than a shorter cut"
+            );
+            last_count = n;
+        }
+        if let Some(m) = &rec.metadata {
+            assert_eq!(m, &metadata());
+            metadata_seen_at.get_or_insert(cut);
+        }
+        assert_eq!(rec.file_bytes, cut as u64);
+    }
+    assert_eq!(last_count, frames.len());
+    assert!(metadata_seen_at.unwrap() < bytes.len() / 4);
+    assert_eq!(full.truncated, None);
+}
+
+#[test]
+fn record_rejects_non_mcap_and_corrupt_files() {
+    let err = read_recording_bytes(b"{\"json\": true}\n").unwrap_err();
+    assert!(matches!(err, RecordError::NotMcap { .. }), "{err}");
+    assert!(err.to_string().contains("89 4d 43 41 50 30 0d 0a"), "{err}");
+
+    let missing = read_recording(&TempFile::new("does-not-exist.mcap")).unwrap_err();
+    assert!(matches!(missing, RecordError::Io { .. }));
+
+    let frames = random_frames(4, 3, true);
+    let (_, bytes) = write_recording("corrupt.mcap", &frames, true);
+    // An impossible length in the header record.
+    let mut bad = bytes.clone();
+    bad[9 + 7] = 0x7f;
+    match read_recording_bytes(&bad).unwrap_err() {
+        RecordError::Corrupt { offset, detail } => {
+            assert_eq!(offset, 8);
+            assert!(detail.contains("declares a length"), "{detail}");
+        }
+        e => panic!("{e}"),
+    }
+    // A flipped byte inside the last chunk's compressed data: frames before it survive.
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let last = summary.chunk_indexes.last().unwrap();
+    let mut bad = bytes.clone();
+    let at = (last.chunk_start_offset + last.chunk_length - 5) as usize;
+    bad[at] ^= 0x40;
+    let rec = read_recording_bytes(&bad).unwrap();
+    assert_frames_bitwise_eq(&rec.frames, &frames[..2]);
+    let msg = rec.truncated.unwrap();
+    assert!(
+        msg.contains(&format!(
+            "corrupt recording at byte {}",
+            last.chunk_start_offset
+        )),
+        "{msg}"
+    );
+}
+
+#[test]
+fn record_fuzzed_files_never_panic() {
+    let frames = random_frames(1234, 5, true);
+    let (_, bytes) = write_recording("fuzz.mcap", &frames, true);
+    let original = read_recording_bytes(&bytes).unwrap();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(77);
+    let (mut ok, mut flagged, mut failed) = (0, 0, 0);
+    for i in 0..400 {
+        let mut data = bytes.clone();
+        let flips = 1 + (i % 3);
+        for _ in 0..flips {
+            let at = (rng.next_u64() % data.len() as u64) as usize;
+            data[at] ^= (1 + rng.next_u64() % 255) as u8;
+        }
+        if i % 4 == 0 {
+            data.truncate((rng.next_u64() % data.len() as u64) as usize);
+        }
+        match std::panic::catch_unwind(|| read_recording_bytes(&data)) {
+            Err(_) => panic!("reader panicked on fuzz case {i}"),
+            Ok(Err(e)) => {
+                if std::env::var_os("MAGSEP_SHOW_FUZZ").is_some() {
+                    eprintln!("{i}: error: {e}");
+                }
+                failed += 1;
+            }
+            Ok(Ok(rec)) if rec.truncated.is_some() => {
+                // Chunk contents are under CRCs: frames read are original frames, in order.
+                let mut rest = original.frames.iter();
+                for f in &rec.frames {
+                    assert!(
+                        rest.any(|o| bits(o) == bits(f)),
+                        "fuzz case {i}: altered frame"
+                    );
+                }
+                if std::env::var_os("MAGSEP_SHOW_FUZZ").is_some() {
+                    eprintln!("{i}: {}", rec.truncated.unwrap());
+                }
+                flagged += 1;
+            }
+            Ok(Ok(rec)) => {
+                // Every byte is under some CRC, so an unflagged read must be the original.
+                assert_eq!(rec.metadata, original.metadata, "fuzz case {i}");
+                assert_eq!(rec.summary_json, original.summary_json, "fuzz case {i}");
+                assert_frames_bitwise_eq(&rec.frames, &original.frames);
+                ok += 1;
+            }
+        }
+    }
+    eprintln!("fuzz: {ok} intact, {flagged} flagged truncated, {failed} rejected");
+    assert!(
+        failed + flagged > 300,
+        "ok {ok}, flagged {flagged}, failed {failed}"
+    );
+}

@@ -1,0 +1,73 @@
+//! `magsep info` and `magsep replay`.
+
+use std::path::Path;
+
+use magsep::plugins::record::{RecordError, read_recording};
+use magsep::replay::{ReplayError, replay as replay_recording};
+use serde_json::json;
+
+use super::CliError;
+
+fn record_error(path: &Path, e: RecordError) -> CliError {
+    match e {
+        RecordError::Io { .. } => CliError::input(format!("{}: {e}", path.display())),
+        other => CliError::input(format!("{} is not a readable recording: {other}", path.display())),
+    }
+}
+
+pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
+    let rec = read_recording(path).map_err(|e| record_error(path, e))?;
+    let channels: Vec<_> = rec
+        .channels
+        .iter()
+        .map(|c| json!({"topic": c.topic, "schema": c.schema_name, "encoding": c.message_encoding, "messages": c.message_count}))
+        .collect();
+    let meta = rec.metadata.as_ref();
+    let v = json!({
+        "file": path.display().to_string(),
+        "bytes": rec.file_bytes,
+        "frames": rec.frames.len(),
+        "first_step": rec.frames.first().map(|f| f.step),
+        "last_step": rec.frames.last().map(|f| f.step),
+        "particles": rec.frames.last().map(|f| f.ids.len()),
+        "channels": channels,
+        "truncated": rec.truncated,
+        "complete": rec.truncated.is_none(),
+        "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
+        "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
+    });
+    if as_json {
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        return Ok(());
+    }
+    println!("file       {} ({} bytes)", path.display(), rec.file_bytes);
+    match &rec.truncated {
+        Some(t) => println!("status     TRUNCATED: {t}"),
+        None => println!("status     complete"),
+    }
+    println!("frames     {} (steps {:?}..{:?})", rec.frames.len(), rec.frames.first().map(|f| f.step), rec.frames.last().map(|f| f.step));
+    println!("channels");
+    for c in &rec.channels {
+        println!("  {:<10} {:<24} {:<10} {} messages", c.topic, c.schema_name, c.message_encoding, c.message_count);
+    }
+    if let Some(m) = meta {
+        println!("metadata   pipeline {}  seed {}  magsep {}  dt {} s", m.pipeline, m.seed, m.version, m.dt);
+        println!("schedule");
+        for (set, systems) in &m.schedule {
+            println!("  {set}: {}", systems.join(", "));
+        }
+        println!("scene text ({} lines)", m.scene_text.lines().count());
+    } else {
+        println!("metadata   none");
+    }
+    Ok(())
+}
+
+pub fn replay(path: &Path) -> Result<(), CliError> {
+    let (summary, _) = replay_recording(path).map_err(|e| match e {
+        ReplayError::Record(r) => record_error(path, r),
+        other => CliError::input(format!("{}: {other}", path.display())),
+    })?;
+    println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+    Ok(())
+}

@@ -1,0 +1,159 @@
+//! The [`Simulation`] builder: scene -> world -> pipeline -> run, with optional recording.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use bevy_ecs::prelude::*;
+use magsep_components::prelude::*;
+use magsep_plugins::app::SimApp;
+use magsep_plugins::group::PipelineGroup;
+use magsep_plugins::packing::packing_pipeline;
+use magsep_plugins::record::{RecordError, RecordingMetadata, RecordingWriter};
+use magsep_plugins::recorder::Recorder;
+
+use crate::scene::{RecordEvery, Scene, SpawnError, spawn_scene};
+use crate::summary::packing_summary;
+
+/// Errors while building or running a simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The scene could not be spawned (e.g. random insertion failed).
+    #[error("spawning the scene failed: {0}")]
+    Spawn(#[from] SpawnError),
+    /// The schedule could not be built (ambiguity, cycle).
+    #[error("building the schedule failed: {0}")]
+    Schedule(String),
+    /// The recording could not be written.
+    #[error("recording failed: {0}")]
+    Record(#[from] RecordError),
+    /// A numerical failure was reported.
+    #[error("numerical failure: {0}")]
+    Health(String),
+}
+
+/// Options of a run beyond the scene.
+#[derive(Clone, Default)]
+pub struct RunOptions {
+    /// Seed overriding `simulation.seed`.
+    pub seed: Option<u64>,
+    /// Write an MCAP recording here.
+    pub record: Option<PathBuf>,
+    /// Use this pipeline instead of the scene's built-in one (custom plugins).
+    pub pipeline: Option<PipelineGroup>,
+    /// Run the schedule on one thread.
+    pub single_threaded: bool,
+}
+
+/// A simulation built from a scene.
+///
+/// ```no_run
+/// use magsep::prelude::*;
+/// let scene = magsep::scene::load_scene("scenes/spheres_500.toml".as_ref(), &Default::default()).unwrap();
+/// let mut sim = Simulation::from_scene(&scene, RunOptions::default()).unwrap();
+/// let summary = sim.run(|_| {}).unwrap();
+/// println!("{summary}");
+/// ```
+pub struct Simulation {
+    /// World and schedules.
+    pub app: SimApp,
+    /// Pipeline name.
+    pub pipeline: String,
+    /// Seed of the run.
+    pub seed: u64,
+    started: Instant,
+}
+
+impl Simulation {
+    /// Spawn `scene`, build its pipeline and open the recording.
+    ///
+    /// # Errors
+    /// [`SimError`] when spawning, building the schedule or opening the recording fails.
+    pub fn from_scene(scene: &Scene, options: RunOptions) -> Result<Self, SimError> {
+        let seed = options.seed.unwrap_or(scene.simulation.seed);
+        let mut app = SimApp::new();
+        if options.single_threaded {
+            app.schedule.set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
+        }
+        spawn_scene(scene, &mut app.world, seed)?;
+        let group = options.pipeline.clone().unwrap_or_else(packing_pipeline);
+        group.build(&mut app);
+        app.finish().map_err(|e| SimError::Schedule(e.to_string()))?;
+        if let Some(path) = &options.record {
+            let meta = RecordingMetadata {
+                scene_text: scene.text.clone(),
+                seed,
+                version: env!("CARGO_PKG_VERSION").to_string(),
+                pipeline: "packing".into(),
+                schedule: app.resolved_schedule(),
+                dt: app.world.resource::<StepClock>().dt,
+            };
+            let writer = RecordingWriter::create(path, &meta)?;
+            let every = app.world.get_resource::<RecordEvery>().map(|r| r.0).unwrap_or(100);
+            app.world.insert_resource(Recorder { writer: Some(writer), every, error: None, last_step: None });
+        }
+        Ok(Self { app, pipeline: "packing".into(), seed, started: Instant::now() })
+    }
+
+    /// Run one step.
+    pub fn step(&mut self) {
+        self.app.step();
+    }
+
+    /// Whether the run has ended.
+    pub fn is_finished(&self) -> bool {
+        self.app.world.get_resource::<PackingStatus>().map(|s| s.stopped.is_some()).unwrap_or(true)
+    }
+
+    /// Step until the run ends; `on_step` sees the world after every step. Finishes the
+    /// recording and returns the summary.
+    ///
+    /// # Errors
+    /// A recording write failure or a reported numerical failure.
+    pub fn run(&mut self, mut on_step: impl FnMut(&World)) -> Result<serde_json::Value, SimError> {
+        self.started = Instant::now();
+        while !self.is_finished() {
+            self.step();
+            on_step(&self.app.world);
+            if let Some(h) = self.app.world.get_resource::<Health>()
+                && h.is_failed()
+            {
+                return Err(SimError::Health(h.messages.join("; ")));
+            }
+        }
+        let summary = self.summary();
+        self.finish_recording(&summary)?;
+        Ok(summary)
+    }
+
+    /// The JSON summary of the current state.
+    pub fn summary(&self) -> serde_json::Value {
+        packing_summary(&self.app.world, self.seed, self.started.elapsed().as_secs_f64())
+    }
+
+    /// Write the summary into the recording and close it.
+    ///
+    /// # Errors
+    /// A recording write failure.
+    pub fn finish_recording(&mut self, summary: &serde_json::Value) -> Result<(), SimError> {
+        if let Some(mut rec) = self.app.world.remove_resource::<Recorder>() {
+            if let Some(e) = rec.error.take() {
+                return Err(SimError::Record(RecordError::InvalidInput { detail: e }));
+            }
+            if let Some(mut w) = rec.writer.take() {
+                w.write_summary(&summary.to_string())?;
+                w.finish()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Load, spawn and run a scene file to the end (convenience for tests and examples).
+///
+/// # Errors
+/// Scene errors (as text) or run errors.
+pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<serde_json::Value, String> {
+    let scene = crate::scene::load_scene(path, &Default::default()).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| e.to_string())?;
+    sim.run(|_| {}).map_err(|e| e.to_string())
+}
