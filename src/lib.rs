@@ -11,6 +11,7 @@
 //! println!("{}", summary["packing_fraction"]);
 //! ```
 
+pub mod bench;
 pub mod chart;
 pub mod replay;
 pub mod scene;

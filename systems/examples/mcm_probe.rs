@@ -15,6 +15,7 @@ fn main() {
     let mut cfg = PackingConfig::defaults_for(n, 1.0);
     cfg.scheme = scheme; cfg.volume_step_rule = rule; cfg.max_attempts = budget_mult * n as u64;
     if let Ok(v) = std::env::var("DT") { cfg.revised_dt = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("XI") { cfg.original_xi = Some(v.parse().unwrap()); }
     if let Ok(v) = std::env::var("BETA") { cfg.original_beta = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("FRAC") { cfg.adaptive_initial_fraction = v.parse().unwrap(); }
     if hl > 10.0 { cfg.initial_packing_fraction = 0.01; }

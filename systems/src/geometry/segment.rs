@@ -1,11 +1,13 @@
 //! Closest points of two line segments (the axes of two spherocylinders).
 //!
 //! Segment i: x_i + s u_i, s in [-h_i, h_i]; segment j: x_j + t u_j, t in [-h_j, h_j], with
-//! unit axes u. The unconstrained minimiser of |r + t u_j - s u_i|^2 (r = x_j - x_i) is
-//! clamped twice ("clamp, project, clamp"), which is exact for segments because the squared
-//! distance is a convex quadratic in (s, t) (spec packing.md, Alg. S; Vega-Lago/Abreu give
-//! the same points). Parallel segments (1 - (u_i.u_j)^2 < 1e-12) take the mid-point of the
-//! overlap of their projections, so the contact point is the middle of a line contact.
+//! unit axes u. The squared distance |r + t u_j - s u_i|^2 (r = x_j - x_i) is a convex
+//! quadratic in (s, t): its minimum is the interior stationary point when that lies in the
+//! rectangle [-h_i, h_i] x [-h_j, h_j], and otherwise on one of the four edges, where a
+//! clamped projection is exact. This is exact to round-off for every pair, including nearly
+//! parallel ones, where the spec's "clamp, project, clamp" (Alg. S) and a mid-point rule are off
+//! by up to angle x length. Exactly parallel segments with overlapping projections (a line
+//! contact) take the middle of the overlap, so the contact point is symmetric.
 
 use glam::DVec3;
 
@@ -35,23 +37,44 @@ pub fn segment_closest(u_i: DVec3, h_i: f64, r: DVec3, u_j: DVec3, h_j: f64) -> 
     let b = u_j.dot(r);
     let c = u_i.dot(u_j);
     let den = 1.0 - c * c;
-    let mut s = if den > 1e-12 {
-        (a - b * c) / den
-    } else {
+    let at = |s: f64, t: f64| SegmentClosest { k: r + t * u_j - s * u_i, s, t };
+    if den > 1e-12 {
+        // interior stationary point of |r + t u_j - s u_i|^2
+        let s0 = (a - b * c) / den;
+        let t0 = (a * c - b) / den;
+        if s0.abs() <= h_i && t0.abs() <= h_j {
+            return at(s0, t0);
+        }
+    }
+    // Otherwise the minimum lies on the boundary of [-h_i, h_i] x [-h_j, h_j]: the best of the
+    // four edges, each minimised exactly (a clamped projection of a convex 1-D quadratic).
+    let mut best = at(h_i, (h_i * c - b).clamp(-h_j, h_j));
+    let mut best_d2 = best.k.length_squared();
+    for cand in [
+        at(-h_i, (-h_i * c - b).clamp(-h_j, h_j)),
+        at((a + h_j * c).clamp(-h_i, h_i), h_j),
+        at((a - h_j * c).clamp(-h_i, h_i), -h_j),
+    ] {
+        let d2 = cand.k.length_squared();
+        if d2 < best_d2 {
+            best = cand;
+            best_d2 = d2;
+        }
+    }
+    if den <= 1e-12 {
+        // (anti)parallel: a line contact; prefer the middle of the overlap of the projections
+        // when it is as close (to round-off), so the contact point is symmetric
         let lo = (-h_i).max(a - h_j);
         let hi = h_i.min(a + h_j);
         if lo <= hi {
-            0.5 * (lo + hi)
-        } else if a > 0.0 {
-            h_i
-        } else {
-            -h_i
+            let sm = 0.5 * (lo + hi);
+            let mid = at(sm, (sm * c - b).clamp(-h_j, h_j));
+            if mid.k.length_squared() <= best_d2 * (1.0 + 1e-14) + 1e-300 {
+                return mid;
+            }
         }
-    };
-    s = s.clamp(-h_i, h_i);
-    let t = (s * c - b).clamp(-h_j, h_j);
-    let s = (a + t * c).clamp(-h_i, h_i);
-    SegmentClosest { k: r + t * u_j - s * u_i, s, t }
+    }
+    best
 }
 
 #[cfg(test)]
@@ -158,7 +181,7 @@ mod tests {
             let rad = 0.1;
             let ci = Capsule::new(Vector::from(-h_i * u_i), Vector::from(h_i * u_i), rad);
             let cj = Capsule::new(Vector::from(r - h_j * u_j), Vector::from(r + h_j * u_j), rad);
-            let d = query::distance(&Pose::IDENTITY, &ci, &Pose::IDENTITY, &cj).unwrap();
+            let d = query::distance(&Pose::IDENTITY, &ci, &Pose::IDENTITY, &cj).unwrap().distance;
             let theirs = d + 2.0 * rad;
             if d > 1e-6 {
                 assert!((ours - theirs).abs() < 1e-6, "{ours} vs parry {theirs}");
