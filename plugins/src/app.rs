@@ -44,6 +44,9 @@ pub trait SimPlugin: Any + Send + Sync {
     }
 }
 
+/// A plugin's `finish` hook, kept until [`SimApp::finish`].
+type FinishHook = Box<dyn Fn(&mut World) + Send + Sync>;
+
 /// World + schedules of one simulation.
 pub struct SimApp {
     /// The ECS world (entities and resources).
@@ -54,7 +57,7 @@ pub struct SimApp {
     pub observe: Schedule,
     /// Registered force contributions, in summation order.
     pub forces: ForceRegistry,
-    plugins: Vec<Box<dyn Fn(&mut World) + Send + Sync>>,
+    plugins: Vec<FinishHook>,
     plugin_names: Vec<String>,
 }
 

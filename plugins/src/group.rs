@@ -24,7 +24,8 @@ impl PipelineGroup {
         Self::default()
     }
 
-    /// Append `plugin` (enabled).
+    /// Append `plugin` (enabled). (Named like bevy's `PluginGroupBuilder::add`.)
+    #[allow(clippy::should_implement_trait)]
     pub fn add<P: SimPlugin>(mut self, plugin: P) -> Self {
         self.entries.push((TypeId::of::<P>(), Arc::new(plugin), true));
         self

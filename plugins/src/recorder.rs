@@ -90,7 +90,7 @@ pub fn record_frame(
         return;
     }
     let stopped = status.as_ref().map(|s| s.stopped.is_some()).unwrap_or(false);
-    if !(stopped || clock.step % rec.every.max(1) == 0) {
+    if !(stopped || clock.step.is_multiple_of(rec.every.max(1))) {
         return;
     }
     let frame = gather_frame(&clock, &container, status.as_deref(), ws.as_deref(), &q);

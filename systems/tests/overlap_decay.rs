@@ -6,7 +6,7 @@
 //!
 //! 1000 configurations as in the thesis (about 5 s in release, 20 s in the default tier).
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use magsep_components::shape::Shape;
 use magsep_systems::packing::contact::pair_contact;
 use magsep_systems::packing::insert::random_orientation;

@@ -113,7 +113,7 @@ pub fn revised_velocities(body: &Body, orientation: DQuat, cs: &[MoveContact]) -
     let iinv = rot * inv_body * rot.transpose();
     let it = iinv * t;
     let lambda = ((f.dot(f) / m + t.dot(it)) / 2.0).sqrt();
-    if !(lambda > 1e-300) {
+    if lambda.is_nan() || lambda <= 1e-300 {
         return None;
     }
     Some((-f / (lambda * m), it / lambda))

@@ -209,8 +209,8 @@ impl NeighbourList {
             count[j as usize] += 1;
         }
         self.start = vec![0; n + 1];
-        for i in 0..n {
-            self.start[i + 1] = self.start[i] + count[i];
+        for (i, c) in count.iter().take(n).enumerate() {
+            self.start[i + 1] = self.start[i] + c;
         }
         let mut fill = self.start.clone();
         self.entries = vec![Neighbour { j: 0, image: [0; 3] }; self.start[n] as usize];

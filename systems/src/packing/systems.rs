@@ -175,7 +175,7 @@ pub struct PackingObservables {
 pub fn should_observe(clock: Res<StepClock>, status: Option<Res<PackingStatus>>, config: Option<Res<PackingConfig>>) -> bool {
     let end = status.map(|s| s.stopped.is_some()).unwrap_or(true);
     let every = config.map(|c| c.observe_every).unwrap_or(0);
-    end || (every > 0 && clock.step % every == 0)
+    end || (every > 0 && clock.step.is_multiple_of(every))
 }
 
 /// Observe: packing fraction, extrapolated contact number and nematic order, from the
