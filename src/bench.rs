@@ -8,7 +8,7 @@ use std::time::Instant;
 use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
 use magsep_components::shape::Shape;
 use magsep_systems::analysis::{contact_numbers, nematic_order};
-use magsep_systems::packing::compress::{DriverParams, compression_step, initial_status, run_removal};
+use magsep_systems::packing::compress::{DriverParams, compression_step, initial_status};
 use magsep_systems::packing::fire::overlap_forces;
 use magsep_systems::packing::insert::random_insertion;
 use magsep_systems::packing::neighbour::NeighbourList;
@@ -275,7 +275,7 @@ mod tests {
         cfg.max_attempts = 50 * 3;
         let p = DriverParams::from_config(&cfg, 1.0);
         let mut rng = particle_stream(1, 1);
-        let out = run_removal(&p, &mut state, &mut list, &mut rng);
+        let out = magsep_systems::packing::compress::run_removal(&p, &mut state, &mut list, &mut rng);
         assert!(out.attempts <= 150 && out.attempts % 50 == 0);
     }
 }

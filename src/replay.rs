@@ -90,7 +90,7 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
     app.world.insert_resource(scene.packing_config());
     load_frame(&mut app.world, frame)?;
     app.add_plugin(&PackingObservePlugin);
-    app.finish().map_err(|e| ReplayError::BadFrame { step: frame.step, detail: e.to_string() })?;
+    app.finish().map_err(|e| ReplayError::BadFrame { step: frame.step, detail: e.0 })?;
     app.observe_now();
     let wall = rec
         .summary_json

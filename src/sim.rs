@@ -77,7 +77,7 @@ impl Simulation {
         spawn_scene(scene, &mut app.world, seed)?;
         let group = options.pipeline.clone().unwrap_or_else(packing_pipeline);
         group.build(&mut app);
-        app.finish().map_err(|e| SimError::Schedule(e.to_string()))?;
+        app.finish().map_err(|e| SimError::Schedule(e.0))?;
         if let Some(path) = &options.record {
             let meta = RecordingMetadata {
                 scene_text: scene.text.clone(),

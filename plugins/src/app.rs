@@ -44,6 +44,20 @@ pub trait SimPlugin: Any + Send + Sync {
     }
 }
 
+/// A schedule that cannot be built (ambiguity, cycle), with the systems named.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ScheduleError(pub String);
+
+fn describe(e: &ScheduleBuildError, schedule: &Schedule, world: &World) -> String {
+    let text = e.to_string(schedule.graph(), world);
+    if matches!(e, ScheduleBuildError::Elevated(_)) || text.to_lowercase().contains("ambigu") {
+        format!("schedule ambiguity (systems with conflicting access and no order): {text}")
+    } else {
+        text
+    }
+}
+
 /// A plugin's `finish` hook, kept until [`SimApp::finish`].
 type FinishHook = Box<dyn Fn(&mut World) + Send + Sync>;
 
@@ -114,14 +128,18 @@ impl SimApp {
     /// (two systems with conflicting access and no order) and cycles.
     ///
     /// # Errors
-    /// The schedule build error of bevy_ecs.
-    pub fn finish(&mut self) -> Result<(), ScheduleBuildError> {
+    /// The schedule build error of bevy_ecs, as text naming the systems involved.
+    pub fn finish(&mut self) -> Result<(), ScheduleError> {
         for f in std::mem::take(&mut self.plugins) {
             f(&mut self.world);
         }
         self.world.insert_resource(self.forces.clone());
-        self.schedule.initialize(&mut self.world)?;
-        self.observe.initialize(&mut self.world)?;
+        if let Err(e) = self.schedule.initialize(&mut self.world) {
+            return Err(ScheduleError(describe(&e, &self.schedule, &self.world)));
+        }
+        if let Err(e) = self.observe.initialize(&mut self.world) {
+            return Err(ScheduleError(describe(&e, &self.observe, &self.world)));
+        }
         Ok(())
     }
 

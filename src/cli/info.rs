@@ -53,8 +53,13 @@ pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
     if let Some(m) = meta {
         println!("metadata   pipeline {}  seed {}  magsep {}  dt {} s", m.pipeline, m.seed, m.version, m.dt);
         println!("schedule");
-        for (set, systems) in &m.schedule {
-            println!("  {set}: {}", systems.join(", "));
+        let order = ["Prepare", "Field", "Dipole", "Contact", "Wall", "Fluid", "Custom", "Accumulate", "Mobility", "Integrate", "Constraints", "Settle", "WriteBack", "Flags", "Clock", "Observe", "Record"];
+        let rank = |s: &str| order.iter().position(|o| s.starts_with(o)).unwrap_or(order.len());
+        let mut sets: Vec<_> = m.schedule.iter().collect();
+        sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
+        for (set, systems) in sets {
+            let short: Vec<String> = systems.iter().map(|s| s.rsplit("::").next().unwrap_or(s).to_string()).collect();
+            println!("  {set:<12} {}", short.join(", "));
         }
         println!("scene text ({} lines)", m.scene_text.lines().count());
     } else {

@@ -37,7 +37,7 @@ fn main() {
         let dvv = next_volume_step(&p, &st, &state);
         compression_step(&p, &mut st, &mut state, &mut list, &mut rng);
         if std::env::var("TRACE").is_ok() { eprintln!("phi {:.4} dv {:.3e} its {} ok {}", st.packing_fraction, dvv, st.last_attempts / n as u64, st.compression_steps != before); }
-        if debug && st.compression_steps != before && st.compression_steps % 20 == 0 {
+        if debug && st.compression_steps != before && st.compression_steps.is_multiple_of(20) {
             let b = brute_max_overlap(&state);
             if b > 1e-4 { println!("step {} phi {:.4} brute max overlap {b:.3e} last_attempts {}", st.compression_steps, st.packing_fraction, st.last_attempts); break; }
         }
