@@ -27,7 +27,11 @@ impl ForceContribution for TrapForce {
 pub struct TrapStiffness(pub f64);
 
 /// Forces::Custom: F = -k (x - centre).
-pub fn compute_trap_force(k: Res<TrapStiffness>, container: Res<Container>, mut q: Query<(&Position, &mut TrapForce)>) {
+pub fn compute_trap_force(
+    k: Res<TrapStiffness>,
+    container: Res<Container>,
+    mut q: Query<(&Position, &mut TrapForce)>,
+) {
     let centre = container.edges() * 0.5;
     for (p, mut f) in &mut q {
         f.0 = -k.0 * (p.0 - centre);
@@ -44,12 +48,17 @@ pub struct TrapPlugin {
 impl SimPlugin for TrapPlugin {
     fn build(&self, app: &mut SimApp) {
         app.world.insert_resource(TrapStiffness(self.stiffness));
-        let ids: Vec<Entity> = app.world.query_filtered::<Entity, With<ParticleId>>().iter(&app.world).collect();
+        let ids: Vec<Entity> = app
+            .world
+            .query_filtered::<Entity, With<ParticleId>>()
+            .iter(&app.world)
+            .collect();
         for e in ids {
             app.world.entity_mut(e).insert(TrapForce::default());
         }
         app.register_force::<TrapForce>();
-        app.schedule.add_systems(compute_trap_force.in_set(ForceSystems::Custom));
+        app.schedule
+            .add_systems(compute_trap_force.in_set(ForceSystems::Custom));
     }
 }
 
@@ -68,7 +77,14 @@ shape = { kind = "sphere", radius = 0.5 }
 pub fn demo() -> (DVec3, DVec3) {
     let scene = parse_scene(SCENE, &Default::default()).expect("valid scene");
     let pipeline = packing_pipeline().add(TrapPlugin { stiffness: 2.0 });
-    let mut sim = Simulation::from_scene(&scene, RunOptions { pipeline: Some(pipeline), ..Default::default() }).expect("builds");
+    let mut sim = Simulation::from_scene(
+        &scene,
+        RunOptions {
+            pipeline: Some(pipeline),
+            ..Default::default()
+        },
+    )
+    .expect("builds");
     for _ in 0..3 {
         sim.step();
     }
@@ -76,7 +92,10 @@ pub fn demo() -> (DVec3, DVec3) {
     // equals the stored contribution (the only one registered).
     let world = &mut sim.app.world;
     let mut q = world.query::<(&ParticleId, &NetForce, &TrapForce)>();
-    let (_, net, trap) = q.iter(world).find(|(id, _, _)| id.0 == 0).expect("particle 0");
+    let (_, net, trap) = q
+        .iter(world)
+        .find(|(id, _, _)| id.0 == 0)
+        .expect("particle 0");
     (net.0, trap.0)
 }
 

@@ -28,7 +28,11 @@ impl ForceContribution for DriftForce {
 pub struct Mobility(pub f64);
 
 /// Integrate: x += mu F dt.
-pub fn integrate_overdamped(clock: Res<StepClock>, mu: Res<Mobility>, mut q: Query<(&NetForce, &mut Position)>) {
+pub fn integrate_overdamped(
+    clock: Res<StepClock>,
+    mu: Res<Mobility>,
+    mut q: Query<(&NetForce, &mut Position)>,
+) {
     for (f, mut p) in &mut q {
         p.0 += mu.0 * f.0 * clock.dt;
     }
@@ -39,11 +43,21 @@ pub fn demo(steps: u64) -> (DVec3, DVec3) {
     let mut world = World::new();
     world.insert_resource(StepClock::new(1e-3));
     world.insert_resource(Mobility(2.0));
-    let e = world.spawn((Position(DVec3::ZERO), DriftForce(DVec3::new(1.0, 0.0, -0.5)), NetForce::default(), NetTorque::default())).id();
+    let e = world
+        .spawn((
+            Position(DVec3::ZERO),
+            DriftForce(DVec3::new(1.0, 0.0, -0.5)),
+            NetForce::default(),
+            NetTorque::default(),
+        ))
+        .id();
     let mut schedule = new_sim_schedule();
     let mut registry = ForceRegistry::default();
     registry.register::<DriftForce>(&mut schedule);
-    schedule.add_systems((integrate_overdamped.in_set(SimSystems::Integrate), advance_clock.in_set(SimSystems::Finalize)));
+    schedule.add_systems((
+        integrate_overdamped.in_set(SimSystems::Integrate),
+        advance_clock.in_set(SimSystems::Finalize),
+    ));
     schedule.initialize(&mut world).expect("no ambiguity");
     for _ in 0..steps {
         schedule.run(&mut world);

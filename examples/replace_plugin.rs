@@ -16,13 +16,27 @@ use magsep::systems::packing::systems::McmWorkspace;
 pub struct AggressiveRemovalRuns(pub u64);
 
 /// Constraints: original rule with beta = 0.9.
-pub fn remove_overlaps_aggressive(mut ws: ResMut<McmWorkspace>, status: Res<PackingStatus>, mut runs: ResMut<AggressiveRemovalRuns>) {
+pub fn remove_overlaps_aggressive(
+    mut ws: ResMut<McmWorkspace>,
+    status: Res<PackingStatus>,
+    mut runs: ResMut<AggressiveRemovalRuns>,
+) {
     if status.stopped.is_some() {
         return;
     }
     let ws = &mut *ws;
     let p = ws.params;
-    ws.outcome = Some(remove_overlaps(&mut ws.state, &mut ws.list, MoveRule::Original { beta: 0.9, xi: None }, p.tolerance, p.max_attempts, &mut ws.rng));
+    ws.outcome = Some(remove_overlaps(
+        &mut ws.state,
+        &mut ws.list,
+        MoveRule::Original {
+            beta: 0.9,
+            xi: None,
+        },
+        p.tolerance,
+        p.max_attempts,
+        &mut ws.rng,
+    ));
     runs.0 += 1;
 }
 
@@ -33,7 +47,8 @@ pub struct AggressiveRemovalPlugin;
 impl SimPlugin for AggressiveRemovalPlugin {
     fn build(&self, app: &mut SimApp) {
         app.world.init_resource::<AggressiveRemovalRuns>();
-        app.schedule.add_systems(remove_overlaps_aggressive.in_set(SimSystems::Constraints));
+        app.schedule
+            .add_systems(remove_overlaps_aggressive.in_set(SimSystems::Constraints));
     }
 }
 
@@ -54,11 +69,29 @@ max_attempts = 12000
 /// schedule of the Constraints set).
 pub fn demo() -> (serde_json::Value, u64, Vec<String>) {
     let scene = parse_scene(SCENE, &Default::default()).expect("valid scene");
-    let pipeline = packing_pipeline().disable::<McmOverlapRemovalPlugin>().add(AggressiveRemovalPlugin);
-    let mut sim = Simulation::from_scene(&scene, RunOptions { pipeline: Some(pipeline), ..Default::default() }).expect("builds");
-    let constraints = sim.app.resolved_schedule().get("Constraints").cloned().unwrap_or_default();
+    let pipeline = packing_pipeline()
+        .disable::<McmOverlapRemovalPlugin>()
+        .add(AggressiveRemovalPlugin);
+    let mut sim = Simulation::from_scene(
+        &scene,
+        RunOptions {
+            pipeline: Some(pipeline),
+            ..Default::default()
+        },
+    )
+    .expect("builds");
+    let constraints = sim
+        .app
+        .resolved_schedule()
+        .get("Constraints")
+        .cloned()
+        .unwrap_or_default();
     let summary = sim.run(|_| {}).expect("runs");
-    (summary, sim.app.world.resource::<AggressiveRemovalRuns>().0, constraints)
+    (
+        summary,
+        sim.app.world.resource::<AggressiveRemovalRuns>().0,
+        constraints,
+    )
 }
 
 fn main() {

@@ -7,7 +7,7 @@ use glam::DVec3;
 use magsep_components::prelude::*;
 use magsep_plugins::app::SimApp;
 use magsep_plugins::packing::PackingObservePlugin;
-use magsep_plugins::record::{ParticleFrame, Recording, RecordError, read_recording};
+use magsep_plugins::record::{ParticleFrame, RecordError, Recording, read_recording};
 use magsep_plugins::recorder::FrameStatus;
 use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
@@ -22,7 +22,9 @@ pub enum ReplayError {
     #[error(transparent)]
     Record(#[from] RecordError),
     /// The recording has no `magsep` metadata record.
-    #[error("the recording has no `magsep` metadata record (scene text, seed): not written by magsep run")]
+    #[error(
+        "the recording has no `magsep` metadata record (scene text, seed): not written by magsep run"
+    )]
     NoMetadata,
     /// The recorded scene does not parse with this version.
     #[error("the recorded scene is invalid:\n{0}")]
@@ -45,13 +47,23 @@ pub enum ReplayError {
 /// # Errors
 /// [`ReplayError::BadFrame`] for non-positive radii or a malformed status.
 pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), ReplayError> {
-    let bad = |detail: String| ReplayError::BadFrame { step: frame.step, detail };
+    let bad = |detail: String| ReplayError::BadFrame {
+        step: frame.step,
+        detail,
+    };
     for (i, id) in frame.ids.iter().enumerate() {
         let (r, h) = (frame.radii[i], frame.half_lengths[i]);
-        if !(r > 0.0) || !(h >= 0.0) {
+        if !(r.is_finite() && r > 0.0 && h.is_finite() && h >= 0.0) {
             return Err(bad(format!("particle {id}: radius {r}, half length {h}")));
         }
-        let shape = if h == 0.0 { Shape::Sphere { radius: r } } else { Shape::Spherocylinder { radius: r, half_length: h } };
+        let shape = if h == 0.0 {
+            Shape::Sphere { radius: r }
+        } else {
+            Shape::Spherocylinder {
+                radius: r,
+                half_length: h,
+            }
+        };
         world.spawn(ParticleBundle {
             id: ParticleId(*id),
             position: Position(frame.positions[i]),
@@ -64,12 +76,22 @@ pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Replay
         });
     }
     let e = frame.box_edges;
-    if !(e.min_element() > 0.0) {
+    if !(e.is_finite() && e.min_element() > 0.0) {
         return Err(bad(format!("box edges {e}")));
     }
-    world.insert_resource(Container::PeriodicBox { edges: DVec3::new(e.x, e.y, e.z) });
-    world.insert_resource(StepClock { step: frame.step, dt: if frame.step > 0 { frame.time / frame.step as f64 } else { 0.0 } });
-    let status: FrameStatus = serde_json::from_str(&frame.status_json).map_err(|e| bad(format!("status_json: {e}")))?;
+    world.insert_resource(Container::PeriodicBox {
+        edges: DVec3::new(e.x, e.y, e.z),
+    });
+    world.insert_resource(StepClock {
+        step: frame.step,
+        dt: if frame.step > 0 {
+            frame.time / frame.step as f64
+        } else {
+            0.0
+        },
+    });
+    let status: FrameStatus =
+        serde_json::from_str(&frame.status_json).map_err(|e| bad(format!("status_json: {e}")))?;
     if let Some(s) = status.packing {
         world.insert_resource(s);
     }
@@ -85,12 +107,22 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
     let rec = read_recording(path)?;
     let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
     let scene = parse_scene(&meta.scene_text, &Default::default())?;
-    let frame = rec.frames.last().ok_or_else(|| ReplayError::NoFrames(rec.truncated.clone().map(|t| format!(" ({t})")).unwrap_or_default()))?;
+    let frame = rec.frames.last().ok_or_else(|| {
+        ReplayError::NoFrames(
+            rec.truncated
+                .clone()
+                .map(|t| format!(" ({t})"))
+                .unwrap_or_default(),
+        )
+    })?;
     let mut app = SimApp::new();
     app.world.insert_resource(scene.packing_config());
     load_frame(&mut app.world, frame)?;
     app.add_plugin(&PackingObservePlugin);
-    app.finish().map_err(|e| ReplayError::BadFrame { step: frame.step, detail: e.0 })?;
+    app.finish().map_err(|e| ReplayError::BadFrame {
+        step: frame.step,
+        detail: e.0,
+    })?;
     app.observe_now();
     let wall = rec
         .summary_json

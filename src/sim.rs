@@ -72,7 +72,8 @@ impl Simulation {
         let seed = options.seed.unwrap_or(scene.simulation.seed);
         let mut app = SimApp::new();
         if options.single_threaded {
-            app.schedule.set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
+            app.schedule
+                .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
         }
         spawn_scene(scene, &mut app.world, seed)?;
         let group = options.pipeline.clone().unwrap_or_else(packing_pipeline);
@@ -88,10 +89,24 @@ impl Simulation {
                 dt: app.world.resource::<StepClock>().dt,
             };
             let writer = RecordingWriter::create(path, &meta)?;
-            let every = app.world.get_resource::<RecordEvery>().map(|r| r.0).unwrap_or(100);
-            app.world.insert_resource(Recorder { writer: Some(writer), every, error: None, last_step: None });
+            let every = app
+                .world
+                .get_resource::<RecordEvery>()
+                .map(|r| r.0)
+                .unwrap_or(100);
+            app.world.insert_resource(Recorder {
+                writer: Some(writer),
+                every,
+                error: None,
+                last_step: None,
+            });
         }
-        Ok(Self { app, pipeline: "packing".into(), seed, started: Instant::now() })
+        Ok(Self {
+            app,
+            pipeline: "packing".into(),
+            seed,
+            started: Instant::now(),
+        })
     }
 
     /// Run one step.
@@ -101,7 +116,11 @@ impl Simulation {
 
     /// Whether the run has ended.
     pub fn is_finished(&self) -> bool {
-        self.app.world.get_resource::<PackingStatus>().map(|s| s.stopped.is_some()).unwrap_or(true)
+        self.app
+            .world
+            .get_resource::<PackingStatus>()
+            .map(|s| s.stopped.is_some())
+            .unwrap_or(true)
     }
 
     /// Step until the run ends; `on_step` sees the world after every step. Finishes the
@@ -127,7 +146,11 @@ impl Simulation {
 
     /// The JSON summary of the current state.
     pub fn summary(&self) -> serde_json::Value {
-        packing_summary(&self.app.world, self.seed, self.started.elapsed().as_secs_f64())
+        packing_summary(
+            &self.app.world,
+            self.seed,
+            self.started.elapsed().as_secs_f64(),
+        )
     }
 
     /// Write the summary into the recording and close it.

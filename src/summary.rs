@@ -25,11 +25,17 @@ pub const PACKING_SUMMARY_KEYS: &[&str] = &[
 
 /// Summary of a packing world: observables, driver counters, warnings, wall time.
 pub fn packing_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
-    let obs = world.get_resource::<PackingObservables>().cloned().unwrap_or_default();
+    let obs = world
+        .get_resource::<PackingObservables>()
+        .cloned()
+        .unwrap_or_default();
     let status = world.get_resource::<PackingStatus>().copied();
     let config = world.get_resource::<PackingConfig>().copied();
     let container = world.get_resource::<Container>().copied();
-    let n = world.iter_entities().filter(|e| e.contains::<ParticleId>()).count();
+    let n = world
+        .iter_entities()
+        .filter(|e| e.contains::<ParticleId>())
+        .count();
     let mut warnings: Vec<String> = Vec::new();
     let (mut final_dv, mut strain) = (Value::Null, Value::Null);
     if let (Some(s), Some(c)) = (status, container) {

@@ -7,7 +7,10 @@ use std::process::{Command, Output};
 use magsep::plugins::record::read_recording;
 
 fn magsep(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_magsep")).args(args).output().expect("binary runs")
+    Command::new(env!("CARGO_BIN_EXE_magsep"))
+        .args(args)
+        .output()
+        .expect("binary runs")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -45,11 +48,31 @@ fn stderr(o: &Output) -> String {
 #[test]
 fn bad_input_gives_exit_2_and_names_the_key() {
     let cases = [
-        ("unknown_key", GOOD.replace("seed = 4", "seed = 4\nsed = 5"), "simulation.sed"),
-        ("negative_radius", GOOD.replace("radius = 0.5 }\n[[", "radius = -1e-9 }\n[["), "particles[0].shape.radius"),
-        ("fraction_above_1", format!("{GOOD}\n[packing]\ninitial_packing_fraction = 1.5\n"), "packing.initial_packing_fraction"),
-        ("count_zero", GOOD.replace("count = 40", "count = 0"), "particles[0].count"),
-        ("non_numeric", GOOD.replace("count = 10", "count = \"ten\""), "particles[1].count"),
+        (
+            "unknown_key",
+            GOOD.replace("seed = 4", "seed = 4\nsed = 5"),
+            "simulation.sed",
+        ),
+        (
+            "negative_radius",
+            GOOD.replace("radius = 0.5 }\n[[", "radius = -1e-9 }\n[["),
+            "particles[0].shape.radius",
+        ),
+        (
+            "fraction_above_1",
+            format!("{GOOD}\n[packing]\ninitial_packing_fraction = 1.5\n"),
+            "packing.initial_packing_fraction",
+        ),
+        (
+            "count_zero",
+            GOOD.replace("count = 40", "count = 0"),
+            "particles[0].count",
+        ),
+        (
+            "non_numeric",
+            GOOD.replace("count = 10", "count = \"ten\""),
+            "particles[1].count",
+        ),
     ];
     for (name, text, key) in cases {
         let p = write(&format!("{name}.toml"), &text);
@@ -57,22 +80,43 @@ fn bad_input_gives_exit_2_and_names_the_key() {
             let o = magsep(&[cmd, p.to_str().unwrap()]);
             let err = stderr(&o);
             assert_eq!(o.status.code(), Some(2), "{name} {cmd}: {err}");
-            assert!(err.contains(key), "{name} {cmd}: expected key {key} in: {err}");
+            assert!(
+                err.contains(key),
+                "{name} {cmd}: expected key {key} in: {err}"
+            );
             assert!(!err.contains("panicked"), "{name}: {err}");
         }
     }
     // several errors in one file are all reported
-    let p = write("many.toml", &GOOD.replace("count = 40", "count = 0").replace("count = 10", "count = \"ten\""));
+    let p = write(
+        "many.toml",
+        &GOOD
+            .replace("count = 40", "count = 0")
+            .replace("count = 10", "count = \"ten\""),
+    );
     let err = stderr(&magsep(&["validate", p.to_str().unwrap()]));
-    assert!(err.contains("particles[0].count") && err.contains("particles[1].count"), "{err}");
+    assert!(
+        err.contains("particles[0].count") && err.contains("particles[1].count"),
+        "{err}"
+    );
     // a missing file and unknown subcommands are bad input too
-    assert_eq!(magsep(&["validate", "/nonexistent/scene.toml"]).status.code(), Some(2));
+    assert_eq!(
+        magsep(&["validate", "/nonexistent/scene.toml"])
+            .status
+            .code(),
+        Some(2)
+    );
     assert_eq!(magsep(&["frobnicate"]).status.code(), Some(2));
     assert_eq!(magsep(&["bench", "nothing"]).status.code(), Some(2));
 }
 
 fn json(o: &Output) -> serde_json::Value {
-    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("stdout is not JSON ({e}): {}", String::from_utf8_lossy(&o.stdout)))
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| {
+        panic!(
+            "stdout is not JSON ({e}): {}",
+            String::from_utf8_lossy(&o.stdout)
+        )
+    })
 }
 
 #[test]
@@ -80,18 +124,48 @@ fn record_info_replay_truncation_and_determinism() {
     let scene = write("good.toml", GOOD);
     let rec1 = tmp("t1.mcap");
     let rec2 = tmp("t2.mcap");
-    let o1 = magsep(&["run", scene.to_str().unwrap(), "--record", rec1.to_str().unwrap(), "--quiet", "--threads", "1"]);
+    let o1 = magsep(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec1.to_str().unwrap(),
+        "--quiet",
+        "--threads",
+        "1",
+    ]);
     assert!(o1.status.success(), "{}", stderr(&o1));
-    let o2 = magsep(&["run", scene.to_str().unwrap(), "--record", rec2.to_str().unwrap(), "--quiet", "--threads", "2"]);
+    let o2 = magsep(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--record",
+        rec2.to_str().unwrap(),
+        "--quiet",
+        "--threads",
+        "2",
+    ]);
     assert!(o2.status.success(), "{}", stderr(&o2));
     let (s1, s2) = (json(&o1), json(&o2));
-    for key in ["pipeline", "particles", "packing_fraction", "mean_contact_number", "nematic_order", "compression_steps", "wall_time_s"] {
+    for key in [
+        "pipeline",
+        "particles",
+        "packing_fraction",
+        "mean_contact_number",
+        "nematic_order",
+        "compression_steps",
+        "wall_time_s",
+    ] {
         assert!(!s1[key].is_null(), "summary lacks {key}: {s1}");
     }
     // determinism: identical state frames at 1 and 2 threads
-    let (r1, r2) = (read_recording(&rec1).unwrap(), read_recording(&rec2).unwrap());
+    let (r1, r2) = (
+        read_recording(&rec1).unwrap(),
+        read_recording(&rec2).unwrap(),
+    );
     assert!(r1.frames.len() >= 2);
-    assert_eq!(r1.frames, r2.frames, "state channel differs between 1 and 2 threads");
+    assert_eq!(
+        r1.frames, r2.frames,
+        "state channel differs between 1 and 2 threads"
+    );
     assert_eq!(s1["packing_fraction"], s2["packing_fraction"]);
     // replay reproduces every summary key exactly (wall time comes from the recording)
     let replay = magsep(&["replay", rec1.to_str().unwrap()]);
@@ -107,9 +181,19 @@ fn record_info_replay_truncation_and_determinism() {
     let vi = json(&info);
     assert_eq!(vi["complete"], true);
     assert_eq!(vi["frames"].as_u64().unwrap() as usize, r1.frames.len());
-    let topics: Vec<_> = vi["channels"].as_array().unwrap().iter().map(|c| c["topic"].as_str().unwrap().to_string()).collect();
+    let topics: Vec<_> = vi["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["topic"].as_str().unwrap().to_string())
+        .collect();
     assert!(topics.contains(&"/state".to_string()) && topics.contains(&"/scene".to_string()));
-    assert!(vi["metadata"]["scene_text"].as_str().unwrap().contains("periodic_box"));
+    assert!(
+        vi["metadata"]["scene_text"]
+            .as_str()
+            .unwrap()
+            .contains("periodic_box")
+    );
     // a recording cut short still yields its finished frames and says so
     let bytes = std::fs::read(&rec1).unwrap();
     let cut = tmp("cut.mcap");

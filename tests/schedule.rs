@@ -36,10 +36,22 @@ shape = { kind = "spherocylinder", radius = 0.25, cylinder_length = 1.0 }
 fn every_shipped_pipeline_builds_with_ambiguity_detection_as_error() {
     let scene = parse_scene(SMALL, &Default::default()).unwrap();
     // the packing pipeline, and the packing pipeline with recording
-    let sim = Simulation::from_scene(&scene, RunOptions::default()).expect("packing pipeline has no ambiguity");
+    let sim = Simulation::from_scene(&scene, RunOptions::default())
+        .expect("packing pipeline has no ambiguity");
     let schedule = sim.app.resolved_schedule();
-    for set in ["Prepare", "Constraints", "Settle", "WriteBack", "Clock", "Observe", "Record"] {
-        assert!(schedule.contains_key(set), "set {set} missing in {schedule:?}");
+    for set in [
+        "Prepare",
+        "Constraints",
+        "Settle",
+        "WriteBack",
+        "Clock",
+        "Observe",
+        "Record",
+    ] {
+        assert!(
+            schedule.contains_key(set),
+            "set {set} missing in {schedule:?}"
+        );
     }
 }
 
@@ -59,22 +71,41 @@ fn an_ambiguous_pair_of_systems_is_a_build_error() {
     impl SimPlugin for Ambiguous {
         fn build(&self, app: &mut SimApp) {
             app.world.init_resource::<Counter>();
-            app.schedule.add_systems((bump_a.in_set(SimSystems::Observe), bump_b.in_set(SimSystems::Observe)));
+            app.schedule.add_systems((
+                bump_a.in_set(SimSystems::Observe),
+                bump_b.in_set(SimSystems::Observe),
+            ));
         }
     }
     let pipeline = packing_pipeline().add(Ambiguous);
-    let err = Simulation::from_scene(&scene, RunOptions { pipeline: Some(pipeline), ..Default::default() }).err().expect("must fail");
+    let err = Simulation::from_scene(
+        &scene,
+        RunOptions {
+            pipeline: Some(pipeline),
+            ..Default::default()
+        },
+    )
+    .err()
+    .expect("must fail");
     assert!(err.to_string().to_lowercase().contains("ambigu"), "{err}");
     // ordering them fixes it
     struct Ordered;
     impl SimPlugin for Ordered {
         fn build(&self, app: &mut SimApp) {
             app.world.init_resource::<Counter>();
-            app.schedule.add_systems((bump_a, bump_b).chain().in_set(SimSystems::Observe));
+            app.schedule
+                .add_systems((bump_a, bump_b).chain().in_set(SimSystems::Observe));
         }
     }
     let pipeline = packing_pipeline().add(Ordered);
-    Simulation::from_scene(&scene, RunOptions { pipeline: Some(pipeline), ..Default::default() }).expect("ordered is fine");
+    Simulation::from_scene(
+        &scene,
+        RunOptions {
+            pipeline: Some(pipeline),
+            ..Default::default()
+        },
+    )
+    .expect("ordered is fine");
 }
 
 #[derive(Component, Default)]
@@ -101,7 +132,14 @@ fn contributions_are_summed_in_registration_order() {
     let a = DVec3::new(1e16, 1.0, -3.3);
     let b = DVec3::new(1.0, 1e-17, 3.3);
     let mut world = World::new();
-    let e = world.spawn((ForceA(a), ForceB(b), NetForce(DVec3::splat(7.0)), NetTorque::default())).id();
+    let e = world
+        .spawn((
+            ForceA(a),
+            ForceB(b),
+            NetForce(DVec3::splat(7.0)),
+            NetTorque::default(),
+        ))
+        .id();
     let mut schedule = new_sim_schedule();
     let mut reg = ForceRegistry::default();
     reg.register::<ForceA>(&mut schedule);
@@ -124,10 +162,23 @@ fn example_a_plugin_registers_a_force_contribution() {
 #[test]
 fn example_b_disabled_plugin_replaced_by_user_plugin() {
     let (summary, runs, constraints) = replace_plugin::demo();
-    assert!(constraints.iter().any(|s| s.contains("remove_overlaps_aggressive")), "{constraints:?}");
-    assert!(!constraints.iter().any(|s| s.contains("remove_overlaps_mcm")), "{constraints:?}");
+    assert!(
+        constraints
+            .iter()
+            .any(|s| s.contains("remove_overlaps_aggressive")),
+        "{constraints:?}"
+    );
+    assert!(
+        !constraints
+            .iter()
+            .any(|s| s.contains("remove_overlaps_mcm")),
+        "{constraints:?}"
+    );
     assert!(runs > 0);
-    assert!(summary["packing_fraction"].as_f64().unwrap() > 0.3, "{summary}");
+    assert!(
+        summary["packing_fraction"].as_f64().unwrap() > 0.3,
+        "{summary}"
+    );
 }
 
 #[test]

@@ -26,7 +26,9 @@ use serde::{Deserialize, Serialize};
 /// let g = GravityForce(DVec3::new(0.0, 0.0, -9.81));
 /// assert_eq!(g.torque(), DVec3::ZERO);
 /// ```
-pub trait ForceContribution: Component<Mutability = bevy_ecs::component::Mutable> + Default {
+pub trait ForceContribution:
+    Component<Mutability = bevy_ecs::component::Mutable> + Default
+{
     /// Force on the particle [N].
     fn force(&self) -> DVec3;
     /// Torque on the particle about its centre [N m]. Default: none.

@@ -27,6 +27,8 @@ pub mod prelude {
     pub use crate::packing::{
         OverlapRemovalScheme, PackingConfig, PackingStatus, StopReason, VolumeStepRule,
     };
-    pub use crate::particle::{Orientation, ParticleBundle, ParticleId, ParticleRng, Position, Species};
+    pub use crate::particle::{
+        Orientation, ParticleBundle, ParticleId, ParticleRng, Position, Species,
+    };
     pub use crate::shape::Shape;
 }

@@ -5,7 +5,9 @@
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleBuildError;
 use magsep_systems::forces::ForceRegistry;
-use magsep_systems::sets::{ObserveSchedule, new_sim_schedule, resolved_schedule, strict_build_settings};
+use magsep_systems::sets::{
+    ObserveSchedule, new_sim_schedule, resolved_schedule, strict_build_settings,
+};
 use std::any::Any;
 use std::collections::BTreeMap;
 
@@ -20,6 +22,7 @@ use std::collections::BTreeMap;
 /// struct Steps(u64);
 /// fn count(mut s: ResMut<Steps>) { s.0 += 1; }
 ///
+/// #[derive(Clone)]
 /// struct CountPlugin;
 /// impl SimPlugin for CountPlugin {
 ///     fn build(&self, app: &mut SimApp) {
@@ -40,7 +43,11 @@ pub trait SimPlugin: Any + Send + Sync {
     fn finish(&self, _world: &mut World) {}
     /// Name shown in the resolved schedule (default: the type name).
     fn name(&self) -> String {
-        std::any::type_name::<Self>().rsplit("::").next().unwrap_or("plugin").to_string()
+        std::any::type_name::<Self>()
+            .rsplit("::")
+            .next()
+            .unwrap_or("plugin")
+            .to_string()
     }
 }
 

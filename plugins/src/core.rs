@@ -37,7 +37,11 @@ impl SimPlugin for CorePlugin {
         }
         app.world.init_resource::<Health>();
         use FinalizeSystems::*;
-        app.schedule.configure_sets((Settle, WriteBack, Flags, Clock).chain().in_set(SimSystems::Finalize));
+        app.schedule.configure_sets(
+            (Settle, WriteBack, Flags, Clock)
+                .chain()
+                .in_set(SimSystems::Finalize),
+        );
         app.schedule.add_systems(advance_clock.in_set(Clock));
     }
 }

@@ -27,7 +27,8 @@ impl PipelineGroup {
     /// Append `plugin` (enabled). (Named like bevy's `PluginGroupBuilder::add`.)
     #[allow(clippy::should_implement_trait)]
     pub fn add<P: SimPlugin>(mut self, plugin: P) -> Self {
-        self.entries.push((TypeId::of::<P>(), Arc::new(plugin), true));
+        self.entries
+            .push((TypeId::of::<P>(), Arc::new(plugin), true));
         self
     }
 
@@ -48,7 +49,11 @@ impl PipelineGroup {
 
     /// Names of the enabled plugins, in order.
     pub fn names(&self) -> Vec<String> {
-        self.entries.iter().filter(|e| e.2).map(|e| e.1.name()).collect()
+        self.entries
+            .iter()
+            .filter(|e| e.2)
+            .map(|e| e.1.name())
+            .collect()
     }
 
     /// Build the enabled plugins into `app`, in order.

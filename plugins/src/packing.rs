@@ -44,7 +44,8 @@ pub struct McmOverlapRemovalPlugin;
 
 impl SimPlugin for McmOverlapRemovalPlugin {
     fn build(&self, app: &mut SimApp) {
-        app.schedule.add_systems(remove_overlaps_mcm.in_set(SimSystems::Constraints));
+        app.schedule
+            .add_systems(remove_overlaps_mcm.in_set(SimSystems::Constraints));
     }
 }
 
@@ -55,7 +56,11 @@ pub struct PackingObservePlugin;
 impl SimPlugin for PackingObservePlugin {
     fn build(&self, app: &mut SimApp) {
         app.world.init_resource::<PackingObservables>();
-        app.schedule.add_systems(observe_packing.run_if(should_observe).in_set(SimSystems::Observe));
+        app.schedule.add_systems(
+            observe_packing
+                .run_if(should_observe)
+                .in_set(SimSystems::Observe),
+        );
         app.observe.add_systems(observe_packing);
     }
 }

@@ -44,13 +44,27 @@ pub struct RecordPlugin;
 impl SimPlugin for RecordPlugin {
     fn build(&self, app: &mut SimApp) {
         if !app.world.contains_resource::<Recorder>() {
-            app.world.insert_resource(Recorder { every: 100, ..Default::default() });
+            app.world.insert_resource(Recorder {
+                every: 100,
+                ..Default::default()
+            });
         }
-        app.schedule.add_systems(record_frame.in_set(SimSystems::Record));
+        app.schedule
+            .add_systems(record_frame.in_set(SimSystems::Record));
     }
 }
 
-type FrameQuery<'w, 's> = Query<'w, 's, (&'static ParticleId, &'static Position, &'static Orientation, &'static Shape, &'static ParticleRng)>;
+type FrameQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static ParticleId,
+        &'static Position,
+        &'static Orientation,
+        &'static Shape,
+        &'static ParticleRng,
+    ),
+>;
 
 /// Gather the lossless frame of the current state (particles in `ParticleId` order).
 pub fn gather_frame(
@@ -62,7 +76,10 @@ pub fn gather_frame(
 ) -> ParticleFrame {
     let mut rows: Vec<_> = q.iter().collect();
     rows.sort_by_key(|r| *r.0);
-    let fs = FrameStatus { packing: status.copied(), driver_rng: ws.map(|w| rng_state_words(&w.rng)) };
+    let fs = FrameStatus {
+        packing: status.copied(),
+        driver_rng: ws.map(|w| rng_state_words(&w.rng)),
+    };
     ParticleFrame {
         step: clock.step,
         time: clock.time(),
@@ -89,7 +106,10 @@ pub fn record_frame(
     if rec.writer.is_none() || rec.last_step == Some(clock.step) {
         return;
     }
-    let stopped = status.as_ref().map(|s| s.stopped.is_some()).unwrap_or(false);
+    let stopped = status
+        .as_ref()
+        .map(|s| s.stopped.is_some())
+        .unwrap_or(false);
     if !(stopped || clock.step.is_multiple_of(rec.every.max(1))) {
         return;
     }

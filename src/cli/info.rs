@@ -11,7 +11,10 @@ use super::CliError;
 fn record_error(path: &Path, e: RecordError) -> CliError {
     match e {
         RecordError::Io { .. } => CliError::input(format!("{}: {e}", path.display())),
-        other => CliError::input(format!("{} is not a readable recording: {other}", path.display())),
+        other => CliError::input(format!(
+            "{} is not a readable recording: {other}",
+            path.display()
+        )),
     }
 }
 
@@ -45,20 +48,57 @@ pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
         Some(t) => println!("status     TRUNCATED: {t}"),
         None => println!("status     complete"),
     }
-    println!("frames     {} (steps {:?}..{:?})", rec.frames.len(), rec.frames.first().map(|f| f.step), rec.frames.last().map(|f| f.step));
+    println!(
+        "frames     {} (steps {:?}..{:?})",
+        rec.frames.len(),
+        rec.frames.first().map(|f| f.step),
+        rec.frames.last().map(|f| f.step)
+    );
     println!("channels");
     for c in &rec.channels {
-        println!("  {:<10} {:<24} {:<10} {} messages", c.topic, c.schema_name, c.message_encoding, c.message_count);
+        println!(
+            "  {:<10} {:<24} {:<10} {} messages",
+            c.topic, c.schema_name, c.message_encoding, c.message_count
+        );
     }
     if let Some(m) = meta {
-        println!("metadata   pipeline {}  seed {}  magsep {}  dt {} s", m.pipeline, m.seed, m.version, m.dt);
+        println!(
+            "metadata   pipeline {}  seed {}  magsep {}  dt {} s",
+            m.pipeline, m.seed, m.version, m.dt
+        );
         println!("schedule");
-        let order = ["Prepare", "Field", "Dipole", "Contact", "Wall", "Fluid", "Custom", "Accumulate", "Mobility", "Integrate", "Constraints", "Settle", "WriteBack", "Flags", "Clock", "Observe", "Record"];
-        let rank = |s: &str| order.iter().position(|o| s.starts_with(o)).unwrap_or(order.len());
+        let order = [
+            "Prepare",
+            "Field",
+            "Dipole",
+            "Contact",
+            "Wall",
+            "Fluid",
+            "Custom",
+            "Accumulate",
+            "Mobility",
+            "Integrate",
+            "Constraints",
+            "Settle",
+            "WriteBack",
+            "Flags",
+            "Clock",
+            "Observe",
+            "Record",
+        ];
+        let rank = |s: &str| {
+            order
+                .iter()
+                .position(|o| s.starts_with(o))
+                .unwrap_or(order.len())
+        };
         let mut sets: Vec<_> = m.schedule.iter().collect();
         sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
         for (set, systems) in sets {
-            let short: Vec<String> = systems.iter().map(|s| s.rsplit("::").next().unwrap_or(s).to_string()).collect();
+            let short: Vec<String> = systems
+                .iter()
+                .map(|s| s.rsplit("::").next().unwrap_or(s).to_string())
+                .collect();
             println!("  {set:<12} {}", short.join(", "));
         }
         println!("scene text ({} lines)", m.scene_text.lines().count());
@@ -73,6 +113,9 @@ pub fn replay(path: &Path) -> Result<(), CliError> {
         ReplayError::Record(r) => record_error(path, r),
         other => CliError::input(format!("{}: {other}", path.display())),
     })?;
-    println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&summary).unwrap_or_default()
+    );
     Ok(())
 }

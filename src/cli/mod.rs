@@ -20,16 +20,26 @@ pub struct CliError {
 impl CliError {
     /// Bad input (exit 2).
     pub fn input(message: impl Into<String>) -> Self {
-        Self { code: 2, message: message.into() }
+        Self {
+            code: 2,
+            message: message.into(),
+        }
     }
     /// Runtime failure (exit 1).
     pub fn runtime(message: impl Into<String>) -> Self {
-        Self { code: 1, message: message.into() }
+        Self {
+            code: 1,
+            message: message.into(),
+        }
     }
 }
 
 #[derive(Parser)]
-#[command(name = "magsep", version, about = "Particles in magnetic separation: packing, fields, Brownian capture, density separation")]
+#[command(
+    name = "magsep",
+    version,
+    about = "Particles in magnetic separation: packing, fields, Brownian capture, density separation"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -107,12 +117,22 @@ pub fn main() -> i32 {
         }
     };
     let result = match cli.command {
-        Command::Run { scene, record, seed, quiet, threads } => run::run(&scene, record, seed, quiet, threads),
+        Command::Run {
+            scene,
+            record,
+            seed,
+            quiet,
+            threads,
+        } => run::run(&scene, record, seed, quiet, threads),
         Command::Validate { scene } => run::validate(&scene),
         Command::Info { recording, json } => info::info(&recording, json),
         Command::Replay { recording } => info::replay(&recording),
-        Command::Bench { what, json, quick } => magsep::bench::bench(&what, json, quick).map_err(to_cli),
-        Command::Chart { what, out, quick } => magsep::bench::chart(&what, &out, quick).map_err(to_cli),
+        Command::Bench { what, json, quick } => {
+            magsep::bench::bench(&what, json, quick).map_err(to_cli)
+        }
+        Command::Chart { what, out, quick } => {
+            magsep::bench::chart(&what, &out, quick).map_err(to_cli)
+        }
     };
     match result {
         Ok(()) => 0,

@@ -24,7 +24,8 @@ pub fn set_threads(threads: Option<usize>) -> Result<bool, CliError> {
 }
 
 pub fn validate(path: &Path) -> Result<(), CliError> {
-    let scene = load_scene(path, &Default::default()).map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
+    let scene = load_scene(path, &Default::default())
+        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
     println!(
         "{}",
         serde_json::json!({"valid": true, "scene": path.display().to_string(), "pipeline": "packing", "particles": scene.total_particles()})
@@ -32,13 +33,33 @@ pub fn validate(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
-pub fn run(path: &Path, record: Option<PathBuf>, seed: Option<u64>, quiet: bool, threads: Option<usize>) -> Result<(), CliError> {
+pub fn run(
+    path: &Path,
+    record: Option<PathBuf>,
+    seed: Option<u64>,
+    quiet: bool,
+    threads: Option<usize>,
+) -> Result<(), CliError> {
     let single = set_threads(threads)?;
-    let scene = load_scene(path, &Default::default()).map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
-    let options = RunOptions { seed, record, pipeline: None, single_threaded: single };
-    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| CliError::runtime(e.to_string()))?;
-    let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
-    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()));
+    let scene = load_scene(path, &Default::default())
+        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
+    let options = RunOptions {
+        seed,
+        record,
+        pipeline: None,
+        single_threaded: single,
+    };
+    let mut sim =
+        Simulation::from_scene(&scene, options).map_err(|e| CliError::runtime(e.to_string()))?;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new_spinner()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
     let summary = sim
         .run(|w| {
             if let Some(s) = w.get_resource::<PackingStatus>() {
@@ -51,9 +72,14 @@ pub fn run(path: &Path, record: Option<PathBuf>, seed: Option<u64>, quiet: bool,
         })
         .map_err(|e| CliError::runtime(e.to_string()))?;
     bar.finish_and_clear();
-    println!("{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&summary).unwrap_or_default()
+    );
     if summary["stop_reason"] == "budget_too_small" {
-        return Err(CliError::runtime("no compression step succeeded: the volume step is too large for the attempt budget (see warnings)"));
+        return Err(CliError::runtime(
+            "no compression step succeeded: the volume step is too large for the attempt budget (see warnings)",
+        ));
     }
     Ok(())
 }

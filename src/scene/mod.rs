@@ -27,7 +27,10 @@ use std::path::Path;
 
 use bevy_ecs::prelude::*;
 
-pub use sections::{ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec, SimulationSection};
+pub use sections::{
+    ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec,
+    SimulationSection,
+};
 pub use spawn::{RecordEvery, SceneText, SpawnError, spawn_scene, spawn_scene_with};
 
 /// One problem in a scene: where (a key path such as `particles[2].shape.radius`) and what.
@@ -42,7 +45,10 @@ pub struct SceneError {
 impl SceneError {
     /// A new error at `path`.
     pub fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { path: path.into(), message: message.into() }
+        Self {
+            path: path.into(),
+            message: message.into(),
+        }
     }
 }
 
@@ -97,7 +103,10 @@ impl SceneRegistry {
 
     /// The kind registered for `key`.
     pub fn get(&self, key: &str) -> Option<&dyn SceneKind> {
-        self.kinds.iter().find(|k| k.key() == key).map(|k| k.as_ref())
+        self.kinds
+            .iter()
+            .find(|k| k.key() == key)
+            .map(|k| k.as_ref())
     }
 
     fn keys(&self) -> Vec<String> {
@@ -140,7 +149,11 @@ pub fn parse_scene(text: &str, registry: &SceneRegistry) -> Result<Scene, SceneE
 /// # Errors
 /// [`SceneErrors`]; an unreadable file is one error with path `(file)`.
 pub fn load_scene(path: &Path, registry: &SceneRegistry) -> Result<Scene, SceneErrors> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneErrors(vec![SceneError::new("(file)", format!("cannot read {}: {e}", path.display()))]))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SceneErrors(vec![SceneError::new(
+            "(file)",
+            format!("cannot read {}: {e}", path.display()),
+        )])
+    })?;
     parse_scene(&text, registry)
 }

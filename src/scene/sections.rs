@@ -57,9 +57,13 @@ impl ShapeSpec {
     pub fn shape(&self) -> Shape {
         match *self {
             ShapeSpec::Sphere { radius } => Shape::Sphere { radius },
-            ShapeSpec::Spherocylinder { radius, cylinder_length } => {
-                Shape::Spherocylinder { radius, half_length: 0.5 * cylinder_length }
-            }
+            ShapeSpec::Spherocylinder {
+                radius,
+                cylinder_length,
+            } => Shape::Spherocylinder {
+                radius,
+                half_length: 0.5 * cylinder_length,
+            },
         }
     }
 }
@@ -127,12 +131,19 @@ impl Scene {
 
     /// One shape per particle, in id order.
     pub fn shapes(&self) -> Vec<Shape> {
-        self.particles.iter().flat_map(|g| std::iter::repeat_n(g.shape.shape(), g.count as usize)).collect()
+        self.particles
+            .iter()
+            .flat_map(|g| std::iter::repeat_n(g.shape.shape(), g.count as usize))
+            .collect()
     }
 
     /// The smallest particle diameter D [m] (1 if there are no particles).
     pub fn reference_diameter(&self) -> f64 {
-        let d = self.particles.iter().map(|g| 2.0 * g.shape.shape().radius()).fold(f64::INFINITY, f64::min);
+        let d = self
+            .particles
+            .iter()
+            .map(|g| 2.0 * g.shape.shape().radius())
+            .fold(f64::INFINITY, f64::min);
         if d.is_finite() { d } else { 1.0 }
     }
 
@@ -148,7 +159,19 @@ impl Scene {
         macro_rules! take {
             ($($f:ident),*) => { $( if let Some(v) = p.$f { c.$f = v; } )* };
         }
-        take!(initial_packing_fraction, volume_step, volume_step_rule, adaptive_initial_fraction, max_attempts, step_halvings, overlap_tolerance, revised_dt, original_beta, max_compression_steps, observe_every);
+        take!(
+            initial_packing_fraction,
+            volume_step,
+            volume_step_rule,
+            adaptive_initial_fraction,
+            max_attempts,
+            step_halvings,
+            overlap_tolerance,
+            revised_dt,
+            original_beta,
+            max_compression_steps,
+            observe_every
+        );
         if p.original_xi.is_some() {
             c.original_xi = p.original_xi;
         }

@@ -44,16 +44,28 @@ pub fn spawn_scene(scene: &Scene, world: &mut World, seed: u64) -> Result<(), Sp
 ///
 /// # Errors
 /// As [`spawn_scene`], and the kinds' own errors.
-pub fn spawn_scene_with(scene: &Scene, world: &mut World, seed: u64, registry: &SceneRegistry) -> Result<(), SpawnError> {
+pub fn spawn_scene_with(
+    scene: &Scene,
+    world: &mut World,
+    seed: u64,
+    registry: &SceneRegistry,
+) -> Result<(), SpawnError> {
     let shapes = scene.shapes();
     let config = scene.packing_config();
     let d = scene.reference_diameter();
     let bodies: Vec<Body> = shapes.iter().map(|s| Body::from_shape(s, d)).collect();
     let volume: f64 = bodies.iter().map(|b| b.volume).sum();
     let edge = (volume / config.initial_packing_fraction).cbrt();
-    let mut rngs: Vec<_> = (0..shapes.len() as u64).map(|i| particle_stream(seed, i)).collect();
+    let mut rngs: Vec<_> = (0..shapes.len() as u64)
+        .map(|i| particle_stream(seed, i))
+        .collect();
     let state = random_insertion(&bodies, edge, &mut rngs)?;
-    let species: Vec<u32> = scene.particles.iter().enumerate().flat_map(|(k, g)| std::iter::repeat_n(k as u32, g.count as usize)).collect();
+    let species: Vec<u32> = scene
+        .particles
+        .iter()
+        .enumerate()
+        .flat_map(|(k, g)| std::iter::repeat_n(k as u32, g.count as usize))
+        .collect();
     for (i, rng) in rngs.into_iter().enumerate() {
         world.spawn(ParticleBundle {
             id: ParticleId(i as u64),
@@ -66,13 +78,17 @@ pub fn spawn_scene_with(scene: &Scene, world: &mut World, seed: u64, registry: &
             net_torque: NetTorque::default(),
         });
     }
-    world.insert_resource(Container::PeriodicBox { edges: DVec3::splat(edge * d) });
+    world.insert_resource(Container::PeriodicBox {
+        edges: DVec3::splat(edge * d),
+    });
     world.insert_resource(config);
     world.insert_resource(StepClock::new(0.0));
     world.insert_resource(RunSeed(seed));
     world.insert_resource(Health::default());
     world.insert_resource(SceneText(scene.text.clone()));
-    world.insert_resource(RecordEvery(scene.record.as_ref().map(|r| r.every).unwrap_or(100)));
+    world.insert_resource(RecordEvery(
+        scene.record.as_ref().map(|r| r.every).unwrap_or(100),
+    ));
     for (key, value) in &scene.extensions {
         if let Some(kind) = registry.get(key) {
             kind.spawn(value, world)?;

@@ -20,7 +20,9 @@ step_halvings = 4
 "#;
 
 fn errors(text: &str) -> Vec<SceneError> {
-    parse_scene(text, &SceneRegistry::default()).expect_err("must be invalid").0
+    parse_scene(text, &SceneRegistry::default())
+        .expect_err("must be invalid")
+        .0
 }
 
 fn has(errs: &[SceneError], path: &str) -> bool {
@@ -33,39 +35,84 @@ fn the_issue_example_parses_with_defaults_resolved() {
     assert_eq!(s.total_particles(), 500);
     let c = s.packing_config();
     assert_eq!(c.max_attempts, 100_000);
-    assert_eq!(c.scheme, magsep_components::packing::OverlapRemovalScheme::Revised);
+    assert_eq!(
+        c.scheme,
+        magsep_components::packing::OverlapRemovalScheme::Revised
+    );
     assert_eq!(s.shapes()[0].half_length(), 2.0);
     // omitted [packing]: documented defaults
     let bare = GOOD.split("[packing]").next().unwrap();
-    let c = parse_scene(bare, &SceneRegistry::default()).unwrap().packing_config();
+    let c = parse_scene(bare, &SceneRegistry::default())
+        .unwrap()
+        .packing_config();
     assert_eq!(c.max_attempts, 20_000 * 500);
     assert!((c.volume_step - 0.1).abs() < 1e-15);
 }
 
 #[test]
 fn each_bad_input_names_its_key() {
-    assert!(has(&errors(&GOOD.replace("seed = 1", "seed = 1\nsed = 2")), "simulation.sed"));
-    assert!(has(&errors(&GOOD.replace("radius = 0.5", "radius = -1e-9")), "particles[0].shape.radius"));
-    assert!(has(&errors(&GOOD.replace("initial_packing_fraction = 0.05", "initial_packing_fraction = 1.5")), "packing.initial_packing_fraction"));
-    assert!(has(&errors(&GOOD.replace("count = 500", "count = 0")), "particles[0].count"));
-    assert!(has(&errors(&GOOD.replace("count = 500", "count = \"abc\"")), "particles[0].count"));
-    assert!(has(&errors(&GOOD.replace("radius = 0.5,", "radiu = 0.5,")), "particles[0].shape.radiu"));
-    assert!(has(&errors(&GOOD.replace("\"spherocylinder\"", "\"cube\"")), "particles[0].shape"));
-    assert!(has(&errors(&format!("{GOOD}\n[magnets]\nx = 1\n")), "magnets"));
-    assert!(has(&errors(&GOOD.replace("[container]\nkind = \"periodic_box\"", "")), "container"));
+    assert!(has(
+        &errors(&GOOD.replace("seed = 1", "seed = 1\nsed = 2")),
+        "simulation.sed"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("radius = 0.5", "radius = -1e-9")),
+        "particles[0].shape.radius"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace(
+            "initial_packing_fraction = 0.05",
+            "initial_packing_fraction = 1.5"
+        )),
+        "packing.initial_packing_fraction"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("count = 500", "count = 0")),
+        "particles[0].count"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("count = 500", "count = \"abc\"")),
+        "particles[0].count"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("radius = 0.5,", "radiu = 0.5,")),
+        "particles[0].shape.radiu"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("\"spherocylinder\"", "\"cube\"")),
+        "particles[0].shape.kind"
+    ));
+    assert!(has(
+        &errors(&format!("{GOOD}\n[magnets]\nx = 1\n")),
+        "magnets"
+    ));
+    assert!(has(
+        &errors(&GOOD.replace("[container]\nkind = \"periodic_box\"", "")),
+        "container"
+    ));
     let syntax = errors("[simulation\npipeline = 1");
     assert!(syntax[0].path.starts_with("(syntax, line 1"), "{syntax:?}");
 }
 
 #[test]
 fn all_errors_are_reported_at_once() {
-    let text = GOOD.replace("count = 500", "count = 0").replace("step_halvings = 4", "step_halvings = 99").replace("volume_step = 0.1", "volume_step = -2.0");
+    let text = GOOD
+        .replace("count = 500", "count = 0")
+        .replace("step_halvings = 4", "step_halvings = 99")
+        .replace("volume_step = 0.1", "volume_step = -2.0");
     let errs = errors(&text);
-    for p in ["particles[0].count", "packing.step_halvings", "packing.volume_step"] {
+    for p in [
+        "particles[0].count",
+        "packing.step_halvings",
+        "packing.volume_step",
+    ] {
         assert!(has(&errs, p), "{p} missing in {errs:?}");
     }
     let shown = SceneErrors(errs).to_string();
-    assert!(shown.contains("got -2") && shown.contains("got 99"), "{shown}");
+    assert!(
+        shown.contains("got -2") && shown.contains("got 99"),
+        "{shown}"
+    );
 }
 
 struct Magnets;
@@ -74,8 +121,15 @@ impl SceneKind for Magnets {
         "magnets"
     }
     fn validate(&self, value: &toml::Value, path: &str, errors: &mut Vec<SceneError>) {
-        if value.get("strength").and_then(|v| v.as_float()).is_none_or(|s| s <= 0.0) {
-            errors.push(SceneError::new(format!("{path}.strength"), "must be a number > 0"));
+        if value
+            .get("strength")
+            .and_then(|v| v.as_float())
+            .is_none_or(|s| s <= 0.0)
+        {
+            errors.push(SceneError::new(
+                format!("{path}.strength"),
+                "must be a number > 0",
+            ));
         }
     }
     fn spawn(&self, _value: &toml::Value, _world: &mut World) -> Result<(), SpawnError> {
@@ -104,13 +158,23 @@ fn mutated_scenes_never_panic() {
             let mut c = chars.clone();
             for _ in 0..3 {
                 let i = rng.random_range(0..c.len());
-                if rng.random::<bool>() { c.remove(i); } else { let ch = c[rng.random_range(0..c.len())]; c.insert(i, ch); }
+                if rng.random::<bool>() {
+                    c.remove(i);
+                } else {
+                    let ch = c[rng.random_range(0..c.len())];
+                    c.insert(i, ch);
+                }
             }
             c.into_iter().collect()
         } else {
             let mut l = lines.clone();
             let i = rng.random_range(0..l.len());
-            if rng.random::<bool>() { l.remove(i); } else { let x = l[rng.random_range(0..l.len())]; l.insert(i, x); }
+            if rng.random::<bool>() {
+                l.remove(i);
+            } else {
+                let x = l[rng.random_range(0..l.len())];
+                l.insert(i, x);
+            }
             l.join("\n")
         };
         let _ = parse_scene(&text, &SceneRegistry::default());
@@ -124,7 +188,8 @@ fn every_shipped_scene_is_valid() {
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         if p.extension().is_some_and(|x| x == "toml") {
-            load_scene(&p, &SceneRegistry::default()).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            load_scene(&p, &SceneRegistry::default())
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
             n += 1;
         }
     }

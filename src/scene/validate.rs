@@ -9,12 +9,21 @@ use super::{CORE_KEYS, Scene, SceneError, SceneRegistry};
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map(|l| l.chars().count()).unwrap_or(0) + 1;
+    let col = before
+        .rsplit('\n')
+        .next()
+        .map(|l| l.chars().count())
+        .unwrap_or(0)
+        + 1;
     (line, col)
 }
 
 /// Deserialize `value` as `T`; a failure becomes an error at `path` + the inner path.
-fn typed<T: DeserializeOwned>(value: &toml::Value, path: &str, errors: &mut Vec<SceneError>) -> Option<T> {
+fn typed<T: DeserializeOwned>(
+    value: &toml::Value,
+    path: &str,
+    errors: &mut Vec<SceneError>,
+) -> Option<T> {
     match serde_path_to_error::deserialize::<_, T>(value.clone()) {
         Ok(v) => Some(v),
         Err(e) => {
@@ -24,18 +33,37 @@ fn typed<T: DeserializeOwned>(value: &toml::Value, path: &str, errors: &mut Vec<
                 (true, i) => i.to_string(),
                 (false, i) => format!("{path}.{i}"),
             };
-            let mut message = e.into_inner().to_string();
+            let raw = e.into_inner().to_string();
+            // toml appends context lines ("in `shape`"); the key path already says where
+            let mut message = raw.lines().next().unwrap_or("").trim().to_string();
             // name the key of an unknown field in the path, as users look for it there
             let mut full = full;
             if let Some(rest) = message.strip_prefix("unknown field `")
                 && let Some(end) = rest.find('`')
             {
-                full = if full.is_empty() { rest[..end].to_string() } else { format!("{full}.{}", &rest[..end]) };
-                message = format!("unknown key; {}", rest[end + 1..].trim_start_matches(',').trim());
+                let key = &rest[..end];
+                if !(full == key || full.ends_with(&format!(".{key}"))) {
+                    full = if full.is_empty() {
+                        key.to_string()
+                    } else {
+                        format!("{full}.{key}")
+                    };
+                }
+                message = format!(
+                    "unknown key; {}",
+                    rest[end + 1..].trim_start_matches(',').trim()
+                );
             } else if let Some(rest) = message.strip_prefix("missing field `")
                 && let Some(end) = rest.find('`')
             {
-                full = if full.is_empty() { rest[..end].to_string() } else { format!("{full}.{}", &rest[..end]) };
+                let key = &rest[..end];
+                if !(full == key || full.ends_with(&format!(".{key}"))) {
+                    full = if full.is_empty() {
+                        key.to_string()
+                    } else {
+                        format!("{full}.{key}")
+                    };
+                }
                 message = "missing required key".into();
             }
             errors.push(SceneError::new(full, message));
@@ -51,11 +79,18 @@ fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl FnOnc
 }
 
 fn finite_positive(errors: &mut Vec<SceneError>, path: &str, v: f64) {
-    check(errors, v.is_finite() && v > 0.0, path, || format!("must be a finite number > 0, got {v}"));
+    check(errors, v.is_finite() && v > 0.0, path, || {
+        format!("must be a finite number > 0, got {v}")
+    });
 }
 
 fn in_range(errors: &mut Vec<SceneError>, path: &str, v: f64, lo_open: f64, hi: f64) {
-    check(errors, v.is_finite() && v > lo_open && v <= hi, path, || format!("must be in ({lo_open}, {hi}], got {v}"));
+    check(
+        errors,
+        v.is_finite() && v > lo_open && v <= hi,
+        path,
+        || format!("must be in ({lo_open}, {hi}], got {v}"),
+    );
 }
 
 /// The whole pipeline of checks.
@@ -66,7 +101,9 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             let e: toml::de::Error = e;
             let at = e.span().map(|s| line_col(text, s.start));
             let msg = e.message().trim().to_string();
-            let path = at.map(|(l, c)| format!("(syntax, line {l}, column {c})")).unwrap_or_else(|| "(syntax)".into());
+            let path = at
+                .map(|(l, c)| format!("(syntax, line {l}, column {c})"))
+                .unwrap_or_else(|| "(syntax)".into());
             return Err(vec![SceneError::new(path, msg)]);
         }
     };
@@ -79,19 +116,31 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut extensions = Vec::new();
     for (key, value) in &table {
         match key.as_str() {
-            "simulation" => simulation = typed::<SimulationSection>(value, "simulation", &mut errors),
+            "simulation" => {
+                simulation = typed::<SimulationSection>(value, "simulation", &mut errors)
+            }
             "container" => container = typed::<ContainerSpec>(value, "container", &mut errors),
-            "packing" => packing = typed::<PackingSection>(value, "packing", &mut errors).unwrap_or_default(),
+            "packing" => {
+                packing = typed::<PackingSection>(value, "packing", &mut errors).unwrap_or_default()
+            }
             "record" => record = typed::<RecordSection>(value, "record", &mut errors),
             "particles" => match value {
                 toml::Value::Array(items) => {
                     for (i, item) in items.iter().enumerate() {
-                        if let Some(g) = typed::<ParticleGroup>(item, &format!("particles[{i}]"), &mut errors) {
+                        if let Some(g) =
+                            typed::<ParticleGroup>(item, &format!("particles[{i}]"), &mut errors)
+                        {
                             particles.push((i, g));
                         }
                     }
                 }
-                other => errors.push(SceneError::new("particles", format!("must be an array of tables ([[particles]]), got a {}", other.type_str()))),
+                other => errors.push(SceneError::new(
+                    "particles",
+                    format!(
+                        "must be an array of tables ([[particles]]), got a {}",
+                        other.type_str()
+                    ),
+                )),
             },
             other => match registry.get(other) {
                 Some(kind) => {
@@ -101,37 +150,68 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 None => {
                     let mut keys: Vec<String> = CORE_KEYS.iter().map(|s| s.to_string()).collect();
                     keys.extend(registry.keys());
-                    errors.push(SceneError::new(other, format!("unknown key; expected one of {}", keys.join(", "))));
+                    errors.push(SceneError::new(
+                        other,
+                        format!("unknown key; expected one of {}", keys.join(", ")),
+                    ));
                 }
             },
         }
     }
     if !table.contains_key("simulation") {
-        errors.push(SceneError::new("simulation", "missing required table [simulation]"));
+        errors.push(SceneError::new(
+            "simulation",
+            "missing required table [simulation]",
+        ));
     }
     if !table.contains_key("container") {
-        errors.push(SceneError::new("container", "missing required table [container]"));
+        errors.push(SceneError::new(
+            "container",
+            "missing required table [container]",
+        ));
     }
     // semantic checks
     let mut total: u64 = 0;
     for (i, g) in &particles {
         let p = format!("particles[{i}]");
-        check(&mut errors, g.count >= 1, &format!("{p}.count"), || format!("must be >= 1, got {}", g.count));
+        check(&mut errors, g.count >= 1, &format!("{p}.count"), || {
+            format!("must be >= 1, got {}", g.count)
+        });
         total = total.saturating_add(g.count);
         match g.shape {
-            ShapeSpec::Sphere { radius } => finite_positive(&mut errors, &format!("{p}.shape.radius"), radius),
-            ShapeSpec::Spherocylinder { radius, cylinder_length } => {
+            ShapeSpec::Sphere { radius } => {
+                finite_positive(&mut errors, &format!("{p}.shape.radius"), radius)
+            }
+            ShapeSpec::Spherocylinder {
+                radius,
+                cylinder_length,
+            } => {
                 finite_positive(&mut errors, &format!("{p}.shape.radius"), radius);
-                check(&mut errors, cylinder_length.is_finite() && cylinder_length >= 0.0, &format!("{p}.shape.cylinder_length"), || {
-                    format!("must be a finite number >= 0, got {cylinder_length}")
-                });
+                check(
+                    &mut errors,
+                    cylinder_length.is_finite() && cylinder_length >= 0.0,
+                    &format!("{p}.shape.cylinder_length"),
+                    || format!("must be a finite number >= 0, got {cylinder_length}"),
+                );
             }
         }
     }
-    if matches!(simulation, Some(SimulationSection { pipeline: PipelineKind::Packing, .. })) && !table.contains_key("particles") {
-        errors.push(SceneError::new("particles", "the packing pipeline needs at least one [[particles]] entry"));
+    if matches!(
+        simulation,
+        Some(SimulationSection {
+            pipeline: PipelineKind::Packing,
+            ..
+        })
+    ) && !table.contains_key("particles")
+    {
+        errors.push(SceneError::new(
+            "particles",
+            "the packing pipeline needs at least one [[particles]] entry",
+        ));
     }
-    check(&mut errors, total <= 10_000_000, "particles", || format!("at most 10^7 particles in all, got {total}"));
+    check(&mut errors, total <= 10_000_000, "particles", || {
+        format!("at most 10^7 particles in all, got {total}")
+    });
     let pk = &packing;
     if let Some(v) = pk.initial_packing_fraction {
         in_range(&mut errors, "packing.initial_packing_fraction", v, 0.0, 0.3);
@@ -140,13 +220,23 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
         finite_positive(&mut errors, "packing.volume_step", v);
     }
     if let Some(v) = pk.adaptive_initial_fraction {
-        in_range(&mut errors, "packing.adaptive_initial_fraction", v, 0.0, 0.5);
+        in_range(
+            &mut errors,
+            "packing.adaptive_initial_fraction",
+            v,
+            0.0,
+            0.5,
+        );
     }
     if let Some(v) = pk.max_attempts {
-        check(&mut errors, v >= 1, "packing.max_attempts", || format!("must be >= 1, got {v}"));
+        check(&mut errors, v >= 1, "packing.max_attempts", || {
+            format!("must be >= 1, got {v}")
+        });
     }
     if let Some(v) = pk.step_halvings {
-        check(&mut errors, v <= 30, "packing.step_halvings", || format!("must be in 0..=30, got {v}"));
+        check(&mut errors, v <= 30, "packing.step_halvings", || {
+            format!("must be in 0..=30, got {v}")
+        });
     }
     if let Some(v) = pk.overlap_tolerance {
         in_range(&mut errors, "packing.overlap_tolerance", v, 0.0, 0.01);
@@ -161,10 +251,14 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
         finite_positive(&mut errors, "packing.original_xi", v);
     }
     if let Some(v) = pk.max_compression_steps {
-        check(&mut errors, v >= 1, "packing.max_compression_steps", || format!("must be >= 1, got {v}"));
+        check(&mut errors, v >= 1, "packing.max_compression_steps", || {
+            format!("must be >= 1, got {v}")
+        });
     }
     if let Some(r) = &record {
-        check(&mut errors, r.every >= 1, "record.every", || format!("must be >= 1, got {}", r.every));
+        check(&mut errors, r.every >= 1, "record.every", || {
+            format!("must be >= 1, got {}", r.every)
+        });
     }
     match (simulation, container, errors.is_empty()) {
         (Some(simulation), Some(container), true) => Ok(Scene {

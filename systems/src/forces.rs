@@ -78,7 +78,9 @@ impl ForceRegistry {
         let n = self.names.len();
         if n == 0 {
             schedule.add_systems(
-                clear_net_force.in_set(SimSystems::Accumulate).before(AccumulateSlot(0)),
+                clear_net_force
+                    .in_set(SimSystems::Accumulate)
+                    .before(AccumulateSlot(0)),
             );
         }
         schedule.configure_sets(AccumulateSlot(n).in_set(SimSystems::Accumulate));

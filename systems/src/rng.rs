@@ -56,7 +56,9 @@ pub fn rng_state_words(rng: &Xoshiro256PlusPlus) -> [u64; 4] {
     }
     // The generator's serde form is {"s": [u64; 4]}: the same words `from_seed` reads.
     let v = serde_json::to_value(rng).expect("xoshiro state serializes");
-    serde_json::from_value::<Words>(v).expect("xoshiro state has four words").s
+    serde_json::from_value::<Words>(v)
+        .expect("xoshiro state has four words")
+        .s
 }
 
 /// Rebuild a generator from [`rng_state_words`].

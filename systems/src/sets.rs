@@ -102,7 +102,10 @@ pub fn new_sim_schedule() -> Schedule {
 
 /// Build settings of every shipped schedule: ambiguities are errors.
 pub fn strict_build_settings() -> ScheduleBuildSettings {
-    ScheduleBuildSettings { ambiguity_detection: LogLevel::Error, ..Default::default() }
+    ScheduleBuildSettings {
+        ambiguity_detection: LogLevel::Error,
+        ..Default::default()
+    }
 }
 
 /// The resolved schedule: for each set (by name) the systems in it, in execution order.

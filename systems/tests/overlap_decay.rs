@@ -22,7 +22,15 @@ fn total_overlap(s: &PackingState) -> f64 {
     for i in 0..3 {
         for j in i + 1..3 {
             let (bi, bj) = (&s.bodies[i], &s.bodies[j]);
-            let c = pair_contact(s.axis(i), bi.half_length, bi.radius, s.positions[j] - s.positions[i], s.axis(j), bj.half_length, bj.radius);
+            let c = pair_contact(
+                s.axis(i),
+                bi.half_length,
+                bi.radius,
+                s.positions[j] - s.positions[i],
+                s.axis(j),
+                bj.half_length,
+                bj.radius,
+            );
             t += c.overlap.max(0.0);
         }
     }
@@ -31,18 +39,41 @@ fn total_overlap(s: &PackingState) -> f64 {
 
 /// Three rods, every pair overlapping by 0 < delta < 0.2 D.
 fn configuration(seed: u64) -> PackingState {
-    let body = Body::from_shape(&Shape::Spherocylinder { radius: 0.5, half_length: 2.0 }, 1.0);
+    let body = Body::from_shape(
+        &Shape::Spherocylinder {
+            radius: 0.5,
+            half_length: 2.0,
+        },
+        1.0,
+    );
     let mut rng = particle_stream(seed, 0);
     loop {
-        let mut s = PackingState { edge: 1000.0, positions: vec![], orientations: vec![], bodies: vec![body; 3] };
+        let mut s = PackingState {
+            edge: 1000.0,
+            positions: vec![],
+            orientations: vec![],
+            bodies: vec![body; 3],
+        };
         for _ in 0..3 {
-            let p = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let p = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
             s.positions.push(p + DVec3::splat(500.0));
             s.orientations.push(random_orientation(&mut rng));
         }
         let ok = (0..3).all(|i| {
             (i + 1..3).all(|j| {
-                let c = pair_contact(s.axis(i), 2.0, 0.5, s.positions[j] - s.positions[i], s.axis(j), 2.0, 0.5);
+                let c = pair_contact(
+                    s.axis(i),
+                    2.0,
+                    0.5,
+                    s.positions[j] - s.positions[i],
+                    s.axis(j),
+                    2.0,
+                    0.5,
+                );
                 c.overlap > 0.0 && c.overlap < 0.2
             })
         });
@@ -81,20 +112,39 @@ fn relax(mut s: PackingState, rule: MoveRule, seed: u64, max_steps: u64) -> Deca
         }
         prev = t;
         if t <= 1e-6 * t0 {
-            return Decay { steps_to_target: Some(step), monotone };
+            return Decay {
+                steps_to_target: Some(step),
+                monotone,
+            };
         }
     }
-    Decay { steps_to_target: None, monotone }
+    Decay {
+        steps_to_target: None,
+        monotone,
+    }
 }
 
 #[test]
 fn three_rod_overlap_decay_reproduces_fig_3_4() {
-    let runs: u64 = std::env::var("RUNS").map(|v| v.parse().unwrap()).unwrap_or(1000);
-    let max_steps: u64 = std::env::var("MAX_STEPS").map(|v| v.parse().unwrap()).unwrap_or(3000);
+    let runs: u64 = std::env::var("RUNS")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(1000);
+    let max_steps: u64 = std::env::var("MAX_STEPS")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(3000);
     let rules = [
         ("a revised", MoveRule::Revised { dt: 0.1 }),
-        ("b original", MoveRule::Original { beta: 0.5, xi: None }),
-        ("c random rotation", MoveRule::RevisedRandomRotation { dt: 0.1 }),
+        (
+            "b original",
+            MoveRule::Original {
+                beta: 0.5,
+                xi: None,
+            },
+        ),
+        (
+            "c random rotation",
+            MoveRule::RevisedRandomRotation { dt: 0.1 },
+        ),
         ("d random both", MoveRule::RevisedRandomBoth { dt: 0.1 }),
     ];
     let mut mean_steps = [0.0f64; 4];
@@ -122,17 +172,29 @@ fn three_rod_overlap_decay_reproduces_fig_3_4() {
         m / (var / d.len() as f64).sqrt()
     };
     for (k, (name, _)) in rules.iter().enumerate() {
-        eprintln!("{name}: mean steps to 1e-6 {:.1}, monotone {}/{runs}, reached {}/{runs}", mean_steps[k], monotone[k], reached[k]);
+        eprintln!(
+            "{name}: mean steps to 1e-6 {:.1}, monotone {}/{runs}, reached {}/{runs}",
+            mean_steps[k], monotone[k], reached[k]
+        );
     }
     // (a) decreases monotonically in >= 95 % of the runs
-    assert!(monotone[0] as f64 >= 0.95 * runs as f64, "revised monotone in {}/{runs}", monotone[0]);
+    assert!(
+        monotone[0] as f64 >= 0.95 * runs as f64,
+        "revised monotone in {}/{runs}",
+        monotone[0]
+    );
     // the median run of (a) reaches 1e-6
     assert!(reached[0] as f64 >= 0.5 * runs as f64);
     // random directions need clearly more steps: (d) > (c) > (a), each significant at
     // more than 3 standard errors of the paired difference
     let (t_ca, t_dc) = (paired_t(0, 2), paired_t(2, 3));
     eprintln!("paired t: (c)-(a) {t_ca:.1}, (d)-(c) {t_dc:.1}");
-    assert!(mean_steps[2] > mean_steps[0] && t_ca > 3.0, "{mean_steps:?} t {t_ca}");
-    assert!(mean_steps[3] > mean_steps[2] && t_dc > 3.0, "{mean_steps:?} t {t_dc}");
+    assert!(
+        mean_steps[2] > mean_steps[0] && t_ca > 3.0,
+        "{mean_steps:?} t {t_ca}"
+    );
+    assert!(
+        mean_steps[3] > mean_steps[2] && t_dc > 3.0,
+        "{mean_steps:?} t {t_dc}"
+    );
 }
-

@@ -41,7 +41,15 @@ pub fn contact_numbers(state: &PackingState) -> ContactNumbers {
     for (i, j, shift) in list.unique_pairs(state.edge) {
         let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
         let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(state.axis(i), bi.half_length, bi.radius, r, state.axis(j), bj.half_length, bj.radius);
+        let c = pair_contact(
+            state.axis(i),
+            bi.half_length,
+            bi.radius,
+            r,
+            state.axis(j),
+            bj.half_length,
+            bj.radius,
+        );
         let gap = -c.overlap;
         max_overlap = max_overlap.max(c.overlap);
         gaps.push(gap);
@@ -63,12 +71,22 @@ pub fn contact_numbers(state: &PackingState) -> ContactNumbers {
     let sxx: f64 = samples.iter().map(|p| p.0 * p.0).sum();
     let sxy: f64 = samples.iter().map(|p| p.0 * p.1).sum();
     let den = m * sxx - sx * sx;
-    let slope = if den.abs() > 0.0 { (m * sxy - sx * sy) / den } else { 0.0 };
+    let slope = if den.abs() > 0.0 {
+        (m * sxy - sx * sy) / den
+    } else {
+        0.0
+    };
     let extrapolated = (sy - slope * sx) / m;
     let maxc = per_particle_small.iter().copied().max().unwrap_or(0) as usize;
     let mut histogram = vec![0u64; maxc + 1];
     for c in per_particle_small {
         histogram[c as usize] += 1;
     }
-    ContactNumbers { extrapolated, at_1e_4: count(1e-4), samples, histogram, max_overlap }
+    ContactNumbers {
+        extrapolated,
+        at_1e_4: count(1e-4),
+        samples,
+        histogram,
+        max_overlap,
+    }
 }

@@ -70,7 +70,10 @@ mod tests {
 
     #[test]
     fn eigenvalues_of_a_rotated_matrix() {
-        let r = DMat3::from_quat(glam::DQuat::from_axis_angle(DVec3::new(1.0, -2.0, 0.3).normalize(), 1.1));
+        let r = DMat3::from_quat(glam::DQuat::from_axis_angle(
+            DVec3::new(1.0, -2.0, 0.3).normalize(),
+            1.1,
+        ));
         let m = r * DMat3::from_diagonal(DVec3::new(-0.5, 0.25, 2.0)) * r.transpose();
         let e = symmetric_eigenvalues(m);
         for (a, b) in e.iter().zip([-0.5, 0.25, 2.0]) {
@@ -84,7 +87,9 @@ mod tests {
         let mut rng = particle_stream(5, 0);
         let mut mean = 0.0;
         for _ in 0..40 {
-            let axes: Vec<DVec3> = (0..500).map(|_| random_orientation(&mut rng) * DVec3::Z).collect();
+            let axes: Vec<DVec3> = (0..500)
+                .map(|_| random_orientation(&mut rng) * DVec3::Z)
+                .collect();
             mean += nematic_order(&axes) / 40.0;
         }
         assert!((mean - 0.036).abs() < 0.008, "{mean}");

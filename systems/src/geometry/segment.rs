@@ -37,7 +37,11 @@ pub fn segment_closest(u_i: DVec3, h_i: f64, r: DVec3, u_j: DVec3, h_j: f64) -> 
     let b = u_j.dot(r);
     let c = u_i.dot(u_j);
     let den = 1.0 - c * c;
-    let at = |s: f64, t: f64| SegmentClosest { k: r + t * u_j - s * u_i, s, t };
+    let at = |s: f64, t: f64| SegmentClosest {
+        k: r + t * u_j - s * u_i,
+        s,
+        t,
+    };
     if den > 1e-12 {
         // interior stationary point of |r + t u_j - s u_i|^2
         let s0 = (a - b * c) / den;
@@ -134,8 +138,8 @@ mod tests {
             let u_i = unit(&mut rng);
             let mut u_j = unit(&mut rng);
             match case % 5 {
-                0 => u_j = u_i,                                     // parallel
-                1 => u_j = -u_i,                                    // anti-parallel
+                0 => u_j = u_i,                                       // parallel
+                1 => u_j = -u_i,                                      // anti-parallel
                 2 => u_j = (u_i + 1e-9 * unit(&mut rng)).normalize(), // nearly parallel
                 _ => {}
             }
@@ -158,7 +162,11 @@ mod tests {
             let b = brute(u_i, h_i, r, u_j, h_j);
             let err = c.k.length() - b;
             worst = worst.max(err.abs());
-            assert!(err.abs() < 1e-9, "case {case}: {} vs brute {b}", c.k.length());
+            assert!(
+                err.abs() < 1e-9,
+                "case {case}: {} vs brute {b}",
+                c.k.length()
+            );
         }
         assert!(worst < 1e-9);
     }
@@ -180,8 +188,14 @@ mod tests {
             let ours = segment_closest(u_i, h_i, r, u_j, h_j).k.length();
             let rad = 0.1;
             let ci = Capsule::new(Vector::from(-h_i * u_i), Vector::from(h_i * u_i), rad);
-            let cj = Capsule::new(Vector::from(r - h_j * u_j), Vector::from(r + h_j * u_j), rad);
-            let d = query::distance(&Pose::IDENTITY, &ci, &Pose::IDENTITY, &cj).unwrap().distance;
+            let cj = Capsule::new(
+                Vector::from(r - h_j * u_j),
+                Vector::from(r + h_j * u_j),
+                rad,
+            );
+            let d = query::distance(&Pose::IDENTITY, &ci, &Pose::IDENTITY, &cj)
+                .unwrap()
+                .distance;
             let theirs = d + 2.0 * rad;
             if d > 1e-6 {
                 assert!((ours - theirs).abs() < 1e-6, "{ours} vs parry {theirs}");

@@ -41,8 +41,8 @@ pub fn inertia_body_unit_density(shape: &Shape) -> DVec3 {
     let r = shape.radius();
     let l = 2.0 * shape.half_length();
     let den = 3.0 * l + 4.0 * r;
-    let ixy = m / 20.0 * (5.0 * l.powi(3) + 20.0 * l * l * r + 45.0 * l * r * r + 32.0 * r.powi(3))
-        / den;
+    let ixy =
+        m / 20.0 * (5.0 * l.powi(3) + 20.0 * l * l * r + 45.0 * l * r * r + 32.0 * r.powi(3)) / den;
     let iz = m / 10.0 * (15.0 * l * r * r + 16.0 * r.powi(3)) / den;
     DVec3::new(ixy, ixy, iz)
 }
@@ -66,7 +66,11 @@ mod tests {
         let (mut v, mut ix, mut iz) = (0.0, 0.0, 0.0);
         for k in 0..n {
             let z = z0 + (k as f64 + 0.5) * dz;
-            let a = if z.abs() <= h { r } else { (r * r - (z.abs() - h).powi(2)).max(0.0).sqrt() };
+            let a = if z.abs() <= h {
+                r
+            } else {
+                (r * r - (z.abs() - h).powi(2)).max(0.0).sqrt()
+            };
             let dm = PI * a * a * dz;
             v += dm;
             iz += 0.5 * dm * a * a;
@@ -78,7 +82,10 @@ mod tests {
     #[test]
     fn spherocylinder_volume_and_inertia_match_slicing_quadrature() {
         for &(r, l) in &[(0.5, 0.0), (0.5, 1.0), (0.5, 4.0), (0.3, 17.0), (2.0, 0.25)] {
-            let s = Shape::Spherocylinder { radius: r, half_length: l / 2.0 };
+            let s = Shape::Spherocylinder {
+                radius: r,
+                half_length: l / 2.0,
+            };
             let (v, ix, iz) = inertia_by_quadrature(r, l);
             let i = inertia_body_unit_density(&s);
             assert!((volume(&s) - v).abs() / v < 1e-8, "V {r} {l}");
@@ -90,14 +97,20 @@ mod tests {
     #[test]
     fn thesis_table_values() {
         // spec packing.md 2.1: Lambda = 5 (L = 4, R = 1/2): V = 3.6652, I_x/m = 1.8893, I_z/m = 0.1214
-        let s = Shape::Spherocylinder { radius: 0.5, half_length: 2.0 };
+        let s = Shape::Spherocylinder {
+            radius: 0.5,
+            half_length: 2.0,
+        };
         let m = volume(&s);
         let i = inertia_body_unit_density(&s);
         assert!((m - 3.6652).abs() < 5e-5);
         assert!((i.x / m - 1.8893).abs() < 5e-5);
         assert!((i.z / m - 0.1214).abs() < 5e-5);
         // sphere limit (2/5) m R^2, to 1e-12 relative
-        let s = Shape::Spherocylinder { radius: 0.7, half_length: 0.0 };
+        let s = Shape::Spherocylinder {
+            radius: 0.7,
+            half_length: 0.0,
+        };
         let i = inertia_body_unit_density(&s);
         let want = 0.4 * volume(&s) * 0.49;
         assert!((i.x - want).abs() / want < 1e-12 && (i.z - want).abs() / want < 1e-12);

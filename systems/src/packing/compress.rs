@@ -46,11 +46,14 @@ impl DriverParams {
     /// From a validated [`PackingConfig`] with reference diameter `d` [m].
     pub fn from_config(c: &PackingConfig, d: f64) -> Self {
         let rule = match c.scheme {
-            magsep_components::packing::OverlapRemovalScheme::Revised => MoveRule::Revised { dt: c.revised_dt },
-            magsep_components::packing::OverlapRemovalScheme::Fire => MoveRule::Fire,
-            magsep_components::packing::OverlapRemovalScheme::Original => {
-                MoveRule::Original { beta: c.original_beta, xi: c.original_xi.map(|x| x / (d * d)) }
+            magsep_components::packing::OverlapRemovalScheme::Revised => {
+                MoveRule::Revised { dt: c.revised_dt }
             }
+            magsep_components::packing::OverlapRemovalScheme::Fire => MoveRule::Fire,
+            magsep_components::packing::OverlapRemovalScheme::Original => MoveRule::Original {
+                beta: c.original_beta,
+                xi: c.original_xi.map(|x| x / (d * d)),
+            },
         };
         Self {
             rule,
@@ -109,7 +112,13 @@ pub fn compress(state: &mut PackingState, list: &mut NeighbourList, dv: f64) -> 
 
 /// Update the status after a removal attempt at volume step `dv`; `restore` is called on
 /// failure to revert the state. Sets `st.stopped` when the run ends.
-pub fn settle_step(p: &DriverParams, st: &mut PackingStatus, dv: f64, out: RemovalOutcome, restore: impl FnOnce()) {
+pub fn settle_step(
+    p: &DriverParams,
+    st: &mut PackingStatus,
+    dv: f64,
+    out: RemovalOutcome,
+    restore: impl FnOnce(),
+) {
     st.attempts += out.attempts;
     st.last_attempts = out.attempts;
     let at_finest = dv <= p.min_volume_step() * (1.0 + 1e-9);
@@ -154,11 +163,22 @@ pub fn settle_step(p: &DriverParams, st: &mut PackingStatus, dv: f64, out: Remov
 }
 
 /// Remove overlaps with the configured rule and budget.
-pub fn run_removal(p: &DriverParams, state: &mut PackingState, list: &mut NeighbourList, rng: &mut impl Rng) -> RemovalOutcome {
+pub fn run_removal(
+    p: &DriverParams,
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    rng: &mut impl Rng,
+) -> RemovalOutcome {
     match p.rule {
         MoveRule::Fire => {
             let iterations = p.max_attempts / (state.len().max(1) as u64);
-            super::fire::remove_overlaps_fire(state, list, super::fire::FireParams::default(), p.tolerance, iterations.max(1))
+            super::fire::remove_overlaps_fire(
+                state,
+                list,
+                super::fire::FireParams::default(),
+                p.tolerance,
+                iterations.max(1),
+            )
         }
         rule => remove_overlaps(state, list, rule, p.tolerance, p.max_attempts, rng),
     }

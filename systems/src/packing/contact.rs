@@ -35,9 +35,21 @@ pub struct PairContact {
 /// assert!((c.overlap - 0.1).abs() < 1e-15 && c.normal == DVec3::X);
 /// ```
 #[inline]
-pub fn pair_contact(u_i: DVec3, h_i: f64, r_i: f64, r: DVec3, u_j: DVec3, h_j: f64, r_j: f64) -> PairContact {
+pub fn pair_contact(
+    u_i: DVec3,
+    h_i: f64,
+    r_i: f64,
+    r: DVec3,
+    u_j: DVec3,
+    h_j: f64,
+    r_j: f64,
+) -> PairContact {
     let c = if h_i == 0.0 && h_j == 0.0 {
-        crate::geometry::SegmentClosest { k: r, s: 0.0, t: 0.0 }
+        crate::geometry::SegmentClosest {
+            k: r,
+            s: 0.0,
+            t: 0.0,
+        }
     } else {
         segment_closest(u_i, h_i, r, u_j, h_j)
     };
@@ -48,7 +60,17 @@ pub fn pair_contact(u_i: DVec3, h_i: f64, r_i: f64, r: DVec3, u_j: DVec3, h_j: f
         // Axes intersect: any direction normal to both axes separates them; fall back to a
         // fixed perpendicular for parallel or zero-length axes (measure-zero configurations).
         let n = u_i.cross(u_j);
-        if n.length_squared() > 1e-24 { n.normalize() } else { u_i.any_orthonormal_vector() }
+        if n.length_squared() > 1e-24 {
+            n.normalize()
+        } else {
+            u_i.any_orthonormal_vector()
+        }
     };
-    PairContact { overlap: r_i + r_j - d, normal, k: c.k, s: c.s, t: c.t }
+    PairContact {
+        overlap: r_i + r_j - d,
+        normal,
+        k: c.k,
+        s: c.s,
+        t: c.t,
+    }
 }

@@ -39,12 +39,20 @@ pub struct FireParams {
 
 impl Default for FireParams {
     fn default() -> Self {
-        Self { dt: 0.1, dt_max: 1.0 }
+        Self {
+            dt: 0.1,
+            dt_max: 1.0,
+        }
     }
 }
 
 /// Forces and torques of the overlap energy; returns (max overlap, energy).
-pub fn overlap_forces(state: &PackingState, list: &NeighbourList, force: &mut [DVec3], torque: &mut [DVec3]) -> (f64, f64) {
+pub fn overlap_forces(
+    state: &PackingState,
+    list: &NeighbourList,
+    force: &mut [DVec3],
+    torque: &mut [DVec3],
+) -> (f64, f64) {
     force.iter_mut().for_each(|f| *f = DVec3::ZERO);
     torque.iter_mut().for_each(|t| *t = DVec3::ZERO);
     let mut max_overlap: f64 = 0.0;
@@ -53,7 +61,15 @@ pub fn overlap_forces(state: &PackingState, list: &NeighbourList, force: &mut [D
         let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
         let (ui, uj) = (state.axis(i), state.axis(j));
         let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(ui, bi.half_length, bi.radius, r, uj, bj.half_length, bj.radius);
+        let c = pair_contact(
+            ui,
+            bi.half_length,
+            bi.radius,
+            r,
+            uj,
+            bj.half_length,
+            bj.radius,
+        );
         if c.overlap <= 0.0 {
             continue;
         }
@@ -85,7 +101,11 @@ pub fn remove_overlaps_fire(
     let mut v = vec![DVec3::ZERO; n];
     let mut w = vec![DVec3::ZERO; n];
     let mass: Vec<f64> = state.bodies.iter().map(|b| b.volume).collect();
-    let rot_inertia: Vec<f64> = state.bodies.iter().map(|b| b.inertia.max_element()).collect();
+    let rot_inertia: Vec<f64> = state
+        .bodies
+        .iter()
+        .map(|b| b.inertia.max_element())
+        .collect();
     let rotates: Vec<bool> = state.bodies.iter().map(|b| b.half_length > 0.0).collect();
     let (mut dt, mut alpha, mut since_negative) = (params.dt, 0.1, 0u64);
     let mut it = 0;
@@ -94,18 +114,30 @@ pub fn remove_overlaps_fire(
         list.ensure(state);
         let (max_overlap, energy) = overlap_forces(state, list, &mut f, &mut t);
         if max_overlap <= tol {
-            return RemovalOutcome { success: true, attempts: it * n as u64, sweeps: it };
+            return RemovalOutcome {
+                success: true,
+                attempts: it * n as u64,
+                sweeps: it,
+            };
         }
         // A jammed configuration relaxes to a minimum with finite energy: when the energy has
         // fallen by less than 2 % over the last STAGNATION_WINDOW iterations, give up early.
         if it % STAGNATION_WINDOW == 0 {
             if it > 0 && energy > 0.98 * window_energy {
-                return RemovalOutcome { success: false, attempts: it * n as u64, sweeps: it };
+                return RemovalOutcome {
+                    success: false,
+                    attempts: it * n as u64,
+                    sweeps: it,
+                };
             }
             window_energy = energy;
         }
         if it >= max_iterations {
-            return RemovalOutcome { success: false, attempts: it * n as u64, sweeps: it };
+            return RemovalOutcome {
+                success: false,
+                attempts: it * n as u64,
+                sweeps: it,
+            };
         }
         it += 1;
         for i in 0..n {
@@ -125,7 +157,11 @@ pub fn remove_overlaps_fire(
             ff += f[i].length_squared() + t[i].length_squared();
         }
         if p > 0.0 {
-            let scale = if ff > 0.0 { alpha * (vv / ff).sqrt() } else { 0.0 };
+            let scale = if ff > 0.0 {
+                alpha * (vv / ff).sqrt()
+            } else {
+                0.0
+            };
             for i in 0..n {
                 v[i] = (1.0 - alpha) * v[i] + scale * f[i];
                 w[i] = (1.0 - alpha) * w[i] + scale * t[i];
@@ -150,7 +186,9 @@ pub fn remove_overlaps_fire(
             state.positions[i] += dx;
             let angle = w[i].length() * dt;
             if angle > 0.0 {
-                state.orientations[i] = (DQuat::from_axis_angle(w[i] / w[i].length(), angle) * state.orientations[i]).normalize();
+                state.orientations[i] = (DQuat::from_axis_angle(w[i] / w[i].length(), angle)
+                    * state.orientations[i])
+                    .normalize();
             }
             let du = state.axis(i) - old_axis;
             list.note_move(i, dx, du, state.bodies[i].half_length);

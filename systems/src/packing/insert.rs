@@ -15,7 +15,9 @@ use super::state::{Body, PackingState};
 
 /// Why insertion failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("random insertion of particle {index} failed after {trials} trials at packing fraction {packing_fraction:.3}; lower initial_packing_fraction")]
+#[error(
+    "random insertion of particle {index} failed after {trials} trials at packing fraction {packing_fraction:.3}; lower initial_packing_fraction"
+)]
 pub struct InsertionError {
     /// Index of the particle that could not be placed.
     pub index: usize,
@@ -39,10 +41,22 @@ pub fn random_orientation(rng: &mut Xoshiro256PlusPlus) -> DQuat {
 
 /// Place `bodies` in a cube of edge `edge` (reduced units) without overlaps. `rngs[i]` is
 /// particle i's stream; they are advanced.
-pub fn random_insertion(bodies: &[Body], edge: f64, rngs: &mut [Xoshiro256PlusPlus]) -> Result<PackingState, InsertionError> {
+pub fn random_insertion(
+    bodies: &[Body],
+    edge: f64,
+    rngs: &mut [Xoshiro256PlusPlus],
+) -> Result<PackingState, InsertionError> {
     let n = bodies.len();
-    let mut state = PackingState { edge, positions: Vec::with_capacity(n), orientations: Vec::with_capacity(n), bodies: Vec::with_capacity(n) };
-    let max_b = bodies.iter().map(|b| b.bounding_radius()).fold(0.0, f64::max);
+    let mut state = PackingState {
+        edge,
+        positions: Vec::with_capacity(n),
+        orientations: Vec::with_capacity(n),
+        bodies: Vec::with_capacity(n),
+    };
+    let max_b = bodies
+        .iter()
+        .map(|b| b.bounding_radius())
+        .fold(0.0, f64::max);
     let cutoff = 2.0 * max_b;
     let ncell = ((edge / cutoff).floor() as i64).max(1);
     let use_cells = ncell >= 3;
@@ -60,9 +74,17 @@ pub fn random_insertion(bodies: &[Body], edge: f64, rngs: &mut [Xoshiro256PlusPl
         loop {
             trials += 1;
             if trials > max_trials {
-                return Err(InsertionError { index: i, trials, packing_fraction: bodies.iter().map(|b| b.volume).sum::<f64>() / edge.powi(3) });
+                return Err(InsertionError {
+                    index: i,
+                    trials,
+                    packing_fraction: bodies.iter().map(|b| b.volume).sum::<f64>() / edge.powi(3),
+                });
             }
-            let p = DVec3::new(rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>()) * edge;
+            let p = DVec3::new(
+                rng.random::<f64>(),
+                rng.random::<f64>(),
+                rng.random::<f64>(),
+            ) * edge;
             let q = random_orientation(rng);
             let u = q * DVec3::Z;
             let overlaps = |j: usize, shift: DVec3| {
@@ -70,7 +92,17 @@ pub fn random_insertion(bodies: &[Body], edge: f64, rngs: &mut [Xoshiro256PlusPl
                 let r = state.positions[j] + shift - p;
                 let reach = body.bounding_radius() + bj.bounding_radius();
                 r.length_squared() < reach * reach
-                    && pair_contact(u, body.half_length, body.radius, r, state.axis(j), bj.half_length, bj.radius).overlap > 0.0
+                    && pair_contact(
+                        u,
+                        body.half_length,
+                        body.radius,
+                        r,
+                        state.axis(j),
+                        bj.half_length,
+                        bj.radius,
+                    )
+                    .overlap
+                        > 0.0
             };
             let mut hit = false;
             if use_cells {
@@ -117,7 +149,18 @@ pub fn random_insertion(bodies: &[Body], edge: f64, rngs: &mut [Xoshiro256PlusPl
                                     continue;
                                 }
                                 let r = DVec3::new(a as f64, b as f64, cc as f64) * edge;
-                                if pair_contact(u, body.half_length, body.radius, r, u, body.half_length, body.radius).overlap > 0.0 {
+                                if pair_contact(
+                                    u,
+                                    body.half_length,
+                                    body.radius,
+                                    r,
+                                    u,
+                                    body.half_length,
+                                    body.radius,
+                                )
+                                .overlap
+                                    > 0.0
+                                {
                                     hit = true;
                                 }
                             }
@@ -128,7 +171,8 @@ pub fn random_insertion(bodies: &[Body], edge: f64, rngs: &mut [Xoshiro256PlusPl
             if !hit {
                 if use_cells {
                     let c = cell_of(p);
-                    cells[((c[0] as usize) * nc + c[1] as usize) * nc + c[2] as usize].push(i as u32);
+                    cells[((c[0] as usize) * nc + c[1] as usize) * nc + c[2] as usize]
+                        .push(i as u32);
                 } else {
                     cells[0].push(i as u32);
                 }

@@ -98,7 +98,11 @@ fn random_unit(rng: &mut impl Rng) -> DVec3 {
 
 /// The revised rule's velocities (v, w) for contacts `cs` (before the delta_min dt scaling).
 /// Returns None when the contact normals cancel (lambda = 0).
-pub fn revised_velocities(body: &Body, orientation: DQuat, cs: &[MoveContact]) -> Option<(DVec3, DVec3)> {
+pub fn revised_velocities(
+    body: &Body,
+    orientation: DQuat,
+    cs: &[MoveContact],
+) -> Option<(DVec3, DVec3)> {
     let mut f = DVec3::ZERO;
     let mut t = DVec3::ZERO;
     for c in cs {
@@ -133,10 +137,15 @@ pub fn overlap_removal_move(
     }
     let delta_min = cs.iter().map(|c| c.overlap).fold(f64::INFINITY, f64::min);
     match rule {
-        MoveRule::Revised { dt } | MoveRule::RevisedRandomRotation { dt } | MoveRule::RevisedRandomBoth { dt } => {
+        MoveRule::Revised { dt }
+        | MoveRule::RevisedRandomRotation { dt }
+        | MoveRule::RevisedRandomBoth { dt } => {
             let (mut v, mut w) = revised_velocities(body, orientation, cs)?;
             let axisymmetric_rod = body.half_length > 0.0;
-            if matches!(rule, MoveRule::RevisedRandomRotation { .. } | MoveRule::RevisedRandomBoth { .. }) {
+            if matches!(
+                rule,
+                MoveRule::RevisedRandomRotation { .. } | MoveRule::RevisedRandomBoth { .. }
+            ) {
                 let mut dir = random_unit(rng);
                 if axisymmetric_rod {
                     // spin about the rod's own axis moves nothing: keep w normal to the axis
@@ -155,7 +164,10 @@ pub fn overlap_removal_move(
             } else {
                 DQuat::IDENTITY
             };
-            Some(Displacement { dx: v * scale, rotation })
+            Some(Displacement {
+                dx: v * scale,
+                rotation,
+            })
         }
         MoveRule::Fire => None,
         MoveRule::Original { beta, xi } => {
@@ -169,7 +181,11 @@ pub fn overlap_removal_move(
                 b += c.overlap * c.s * ksep;
             }
             // components of sum(delta l k_sep) along e_x and e_y: the part normal to the axis
-            let wa = if body.half_length > 0.0 { (b - b.dot(axis) * axis) / xi } else { DVec3::ZERO };
+            let wa = if body.half_length > 0.0 {
+                (b - b.dot(axis) * axis) / xi
+            } else {
+                DVec3::ZERO
+            };
             let mut best = f64::INFINITY;
             for c in cs {
                 let ksep = -c.k;
@@ -192,7 +208,10 @@ pub fn overlap_removal_move(
             } else {
                 DQuat::from_rotation_arc(axis, new_axis)
             };
-            Some(Displacement { dx: v * step, rotation })
+            Some(Displacement {
+                dx: v * step,
+                rotation,
+            })
         }
     }
 }
@@ -206,10 +225,21 @@ mod tests {
 
     #[test]
     fn revised_single_contact_energy_constraint_and_separation() {
-        let body = Body::from_shape(&Shape::Spherocylinder { radius: 0.5, half_length: 2.0 }, 1.0);
+        let body = Body::from_shape(
+            &Shape::Spherocylinder {
+                radius: 0.5,
+                half_length: 2.0,
+            },
+            1.0,
+        );
         let q = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
         let n = DVec3::new(0.3, -0.2, 0.9).normalize();
-        let c = MoveContact { overlap: 0.05, normal: n, k: n * 0.95, s: 1.3 };
+        let c = MoveContact {
+            overlap: 0.05,
+            normal: n,
+            k: n * 0.95,
+            s: 1.3,
+        };
         let (v, w) = revised_velocities(&body, q, &[c]).unwrap();
         // kinetic-energy constraint c = 1 (eq. 3.4) to 1e-12
         let rot = DMat3::from_quat(q);
@@ -221,7 +251,8 @@ mod tests {
         assert!((v + w.cross(rc)).dot(n) < 0.0);
         // step length bound |dx| <= delta_min dt sqrt(2c/m)
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-        let d = overlap_removal_move(MoveRule::Revised { dt: 0.1 }, &body, q, &[c], &mut rng).unwrap();
+        let d =
+            overlap_removal_move(MoveRule::Revised { dt: 0.1 }, &body, q, &[c], &mut rng).unwrap();
         assert!(d.dx.length() <= 0.05 * 0.1 * (2.0 / body.volume).sqrt() * (1.0 + 1e-12));
     }
 
@@ -230,10 +261,24 @@ mod tests {
         // two unit-diameter spheres with overlap 0.1: beta = 1/2 moves i by delta/2 away from j
         let body = Body::from_shape(&Shape::Sphere { radius: 0.5 }, 1.0);
         let k = DVec3::new(0.9, 0.0, 0.0);
-        let c = MoveContact { overlap: 0.1, normal: DVec3::X, k, s: 0.0 };
+        let c = MoveContact {
+            overlap: 0.1,
+            normal: DVec3::X,
+            k,
+            s: 0.0,
+        };
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-        let d = overlap_removal_move(MoveRule::Original { beta: 0.5, xi: None }, &body, DQuat::IDENTITY, &[c], &mut rng)
-            .unwrap();
+        let d = overlap_removal_move(
+            MoveRule::Original {
+                beta: 0.5,
+                xi: None,
+            },
+            &body,
+            DQuat::IDENTITY,
+            &[c],
+            &mut rng,
+        )
+        .unwrap();
         assert!((d.dx - DVec3::new(-0.05, 0.0, 0.0)).length() < 1e-15);
     }
 }

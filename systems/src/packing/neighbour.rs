@@ -30,7 +30,11 @@ impl Neighbour {
     /// The image shift for a box of edge `edge`.
     #[inline]
     pub fn shift(&self, edge: f64) -> DVec3 {
-        DVec3::new(self.image[0] as f64, self.image[1] as f64, self.image[2] as f64) * edge
+        DVec3::new(
+            self.image[0] as f64,
+            self.image[1] as f64,
+            self.image[2] as f64,
+        ) * edge
     }
 }
 
@@ -62,7 +66,10 @@ pub struct NeighbourList {
 impl NeighbourList {
     /// An empty list with `skin` (reduced units).
     pub fn new(skin: f64) -> Self {
-        Self { skin, ..Default::default() }
+        Self {
+            skin,
+            ..Default::default()
+        }
     }
 
     /// Neighbours of particle `i`.
@@ -126,7 +133,11 @@ impl NeighbourList {
         }
         let state = &*state;
         let n = state.len();
-        let max_b = state.bodies.iter().map(|b| b.bounding_radius()).fold(0.0, f64::max);
+        let max_b = state
+            .bodies
+            .iter()
+            .map(|b| b.bounding_radius())
+            .fold(0.0, f64::max);
         let cutoff = 2.0 * max_b + self.skin;
         self.centre_range = cutoff;
         let axes: Vec<DVec3> = (0..n).map(|i| state.axis(i)).collect();
@@ -149,7 +160,9 @@ impl NeighbourList {
         if ncell >= 3 {
             let nc = ncell as usize;
             let cell_of = |p: DVec3| -> [usize; 3] {
-                let f = |c: f64| (((c / l) * nc as f64).floor() as i64).clamp(0, nc as i64 - 1) as usize;
+                let f = |c: f64| {
+                    (((c / l) * nc as f64).floor() as i64).clamp(0, nc as i64 - 1) as usize
+                };
                 [f(p.x), f(p.y), f(p.z)]
             };
             let mut head = vec![u32::MAX; nc * nc * nc];
@@ -213,12 +226,21 @@ impl NeighbourList {
             self.start[i + 1] = self.start[i] + c;
         }
         let mut fill = self.start.clone();
-        self.entries = vec![Neighbour { j: 0, image: [0; 3] }; self.start[n] as usize];
+        self.entries = vec![
+            Neighbour {
+                j: 0,
+                image: [0; 3]
+            };
+            self.start[n] as usize
+        ];
         for &(i, j, shift) in &pairs {
             let image = image_of(shift, l);
             self.entries[fill[i as usize] as usize] = Neighbour { j, image };
             fill[i as usize] += 1;
-            self.entries[fill[j as usize] as usize] = Neighbour { j: i, image: image.map(|x| -x) };
+            self.entries[fill[j as usize] as usize] = Neighbour {
+                j: i,
+                image: image.map(|x| -x),
+            };
             fill[j as usize] += 1;
         }
         self.moved = vec![0.0; n];

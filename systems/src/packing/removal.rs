@@ -28,7 +28,13 @@ pub struct RemovalOutcome {
 }
 
 /// Overlapping contacts (overlap > `tol`) of particle `i`, written into `out`.
-pub fn overlapping_contacts(state: &PackingState, list: &NeighbourList, i: usize, tol: f64, out: &mut Vec<MoveContact>) {
+pub fn overlapping_contacts(
+    state: &PackingState,
+    list: &NeighbourList,
+    i: usize,
+    tol: f64,
+    out: &mut Vec<MoveContact>,
+) {
     out.clear();
     let bi = &state.bodies[i];
     let ui = state.axis(i);
@@ -37,23 +43,49 @@ pub fn overlapping_contacts(state: &PackingState, list: &NeighbourList, i: usize
         let j = nb.j as usize;
         let bj = &state.bodies[j];
         let r = state.positions[j] + nb.shift(state.edge) - xi;
-        let c = pair_contact(ui, bi.half_length, bi.radius, r, state.axis(j), bj.half_length, bj.radius);
+        let c = pair_contact(
+            ui,
+            bi.half_length,
+            bi.radius,
+            r,
+            state.axis(j),
+            bj.half_length,
+            bj.radius,
+        );
         if c.overlap > tol {
-            out.push(MoveContact { overlap: c.overlap, normal: c.normal, k: c.k, s: c.s });
+            out.push(MoveContact {
+                overlap: c.overlap,
+                normal: c.normal,
+                k: c.k,
+                s: c.s,
+            });
         }
     }
 }
 
 /// Total overlap (sum over unique pairs of max(overlap, 0)) and the flags of particles with an
 /// overlap above `tol`.
-pub fn overlap_scan(state: &PackingState, list: &NeighbourList, tol: f64, flags: &mut Vec<bool>) -> f64 {
+pub fn overlap_scan(
+    state: &PackingState,
+    list: &NeighbourList,
+    tol: f64,
+    flags: &mut Vec<bool>,
+) -> f64 {
     flags.clear();
     flags.resize(state.len(), false);
     let mut total = 0.0;
     for (i, j, shift) in list.unique_pairs(state.edge) {
         let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
         let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(state.axis(i), bi.half_length, bi.radius, r, state.axis(j), bj.half_length, bj.radius);
+        let c = pair_contact(
+            state.axis(i),
+            bi.half_length,
+            bi.radius,
+            r,
+            state.axis(j),
+            bj.half_length,
+            bj.radius,
+        );
         if c.overlap > 0.0 {
             total += c.overlap;
         }
@@ -107,12 +139,26 @@ pub fn remove_overlaps(
         list.ensure(state);
         overlap_scan(state, list, tol, &mut flags);
         order.clear();
-        order.extend(flags.iter().enumerate().filter(|(_, f)| **f).map(|(i, _)| i));
+        order.extend(
+            flags
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| **f)
+                .map(|(i, _)| i),
+        );
         if order.is_empty() {
-            return RemovalOutcome { success: true, attempts, sweeps };
+            return RemovalOutcome {
+                success: true,
+                attempts,
+                sweeps,
+            };
         }
         if attempts >= budget {
-            return RemovalOutcome { success: false, attempts, sweeps };
+            return RemovalOutcome {
+                success: false,
+                attempts,
+                sweeps,
+            };
         }
         order.shuffle(rng);
         let mut moved_any = false;
@@ -131,7 +177,11 @@ pub fn remove_overlaps(
         sweeps += 1;
         if !moved_any {
             // every overlapping particle is stuck (no positive-rate contact): spend the budget
-            return RemovalOutcome { success: false, attempts: budget.max(attempts), sweeps };
+            return RemovalOutcome {
+                success: false,
+                attempts: budget.max(attempts),
+                sweeps,
+            };
         }
     }
 }

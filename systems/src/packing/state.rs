@@ -31,9 +31,13 @@ impl Body {
     pub fn from_shape(shape: &Shape, d: f64) -> Self {
         let scaled = match *shape {
             Shape::Sphere { radius } => Shape::Sphere { radius: radius / d },
-            Shape::Spherocylinder { radius, half_length } => {
-                Shape::Spherocylinder { radius: radius / d, half_length: half_length / d }
-            }
+            Shape::Spherocylinder {
+                radius,
+                half_length,
+            } => Shape::Spherocylinder {
+                radius: radius / d,
+                half_length: half_length / d,
+            },
         };
         let v = volume(&scaled);
         let inertia = inertia_body_unit_density(&scaled);
@@ -67,7 +71,13 @@ pub struct PackingState {
 
 impl PackingState {
     /// Build from SI data; `d` is the reference diameter [m].
-    pub fn from_si(edge: f64, positions: &[DVec3], orientations: &[DQuat], shapes: &[Shape], d: f64) -> Self {
+    pub fn from_si(
+        edge: f64,
+        positions: &[DVec3],
+        orientations: &[DQuat],
+        shapes: &[Shape],
+        d: f64,
+    ) -> Self {
         Self {
             edge: edge / d,
             positions: positions.iter().map(|p| *p / d).collect(),
@@ -78,7 +88,10 @@ impl PackingState {
 
     /// Edge [m] and positions [m] for reference diameter `d`.
     pub fn to_si(&self, d: f64) -> (f64, Vec<DVec3>) {
-        (self.edge * d, self.positions.iter().map(|p| *p * d).collect())
+        (
+            self.edge * d,
+            self.positions.iter().map(|p| *p * d).collect(),
+        )
     }
 
     /// Number of particles.

@@ -48,10 +48,16 @@ pub const MCM_SKIN: f64 = 0.1;
 /// Build the workspace from the spawned particles (exclusive; call once after spawning).
 pub fn init_mcm_workspace(world: &mut World) {
     let config = *world.resource::<PackingConfig>();
-    let seed = world.get_resource::<crate::RunSeed>().map(|s| s.0).unwrap_or(0);
+    let seed = world
+        .get_resource::<crate::RunSeed>()
+        .map(|s| s.0)
+        .unwrap_or(0);
     let edge = world.resource::<Container>().edges().x;
     let mut q = world.query::<(Entity, &ParticleId, &Position, &Orientation, &Shape)>();
-    let mut rows: Vec<_> = q.iter(world).map(|(e, id, p, o, s)| (*id, e, p.0, o.0, *s)).collect();
+    let mut rows: Vec<_> = q
+        .iter(world)
+        .map(|(e, id, p, o, s)| (*id, e, p.0, o.0, *s))
+        .collect();
     rows.sort_by_key(|r| r.0);
     let d = reference_diameter(rows.iter().map(|r| &r.4));
     let positions: Vec<DVec3> = rows.iter().map(|r| r.2).collect();
@@ -70,7 +76,10 @@ pub fn init_mcm_workspace(world: &mut World) {
         state,
         saved: None,
         list: NeighbourList::new(MCM_SKIN),
-        rng: world.get_resource::<DriverRng>().map(|r| r.0.clone()).unwrap_or_else(|| particle_stream(seed, DRIVER_STREAM)),
+        rng: world
+            .get_resource::<DriverRng>()
+            .map(|r| r.0.clone())
+            .unwrap_or_else(|| particle_stream(seed, DRIVER_STREAM)),
         reference_diameter: d,
         entities: rows.iter().map(|r| r.1).collect(),
         current_volume_step: 0.0,
@@ -85,7 +94,9 @@ pub struct DriverRng(pub Xoshiro256PlusPlus);
 
 /// The reference diameter of a set of shapes: the smallest particle diameter 2R [m].
 pub fn reference_diameter<'a>(shapes: impl Iterator<Item = &'a Shape>) -> f64 {
-    let d = shapes.map(|s| 2.0 * s.radius()).fold(f64::INFINITY, f64::min);
+    let d = shapes
+        .map(|s| 2.0 * s.radius())
+        .fold(f64::INFINITY, f64::min);
     if d.is_finite() { d } else { 1.0 }
 }
 
@@ -108,7 +119,12 @@ pub fn remove_overlaps_mcm(mut ws: ResMut<McmWorkspace>, status: Res<PackingStat
     }
     let ws = &mut *ws;
     let p = ws.params;
-    ws.outcome = Some(super::compress::run_removal(&p, &mut ws.state, &mut ws.list, &mut ws.rng));
+    ws.outcome = Some(super::compress::run_removal(
+        &p,
+        &mut ws.state,
+        &mut ws.list,
+        &mut ws.rng,
+    ));
 }
 
 /// Finalize: accept the step, or revert and refine it; decide whether the run ends.
@@ -140,7 +156,9 @@ pub fn write_back_particles(
     let mut wrapped = ws.state.clone();
     wrapped.wrap_all();
     let (edge, positions) = wrapped.to_si(d);
-    *container = Container::PeriodicBox { edges: DVec3::splat(edge) };
+    *container = Container::PeriodicBox {
+        edges: DVec3::splat(edge),
+    };
     for (k, e) in ws.entities.iter().enumerate() {
         if let Ok((mut p, mut o)) = q.get_mut(*e) {
             p.0 = positions[k];
@@ -172,7 +190,11 @@ pub struct PackingObservables {
 
 /// Whether [`observe_packing`] runs this step: at the end of the run, and every
 /// `observe_every` steps.
-pub fn should_observe(clock: Res<StepClock>, status: Option<Res<PackingStatus>>, config: Option<Res<PackingConfig>>) -> bool {
+pub fn should_observe(
+    clock: Res<StepClock>,
+    status: Option<Res<PackingStatus>>,
+    config: Option<Res<PackingConfig>>,
+) -> bool {
     let end = status.map(|s| s.stopped.is_some()).unwrap_or(true);
     let every = config.map(|c| c.observe_every).unwrap_or(0);
     end || (every > 0 && clock.step.is_multiple_of(every))
@@ -194,7 +216,10 @@ pub fn observe_packing(
     let orientations: Vec<DQuat> = rows.iter().map(|r| r.2).collect();
     let state = PackingState::from_si(container.edges().x, &positions, &orientations, &shapes, d);
     let cn = contact_numbers(&state);
-    let rod_axes: Vec<DVec3> = (0..state.len()).filter(|&i| state.bodies[i].half_length > 0.0).map(|i| state.axis(i)).collect();
+    let rod_axes: Vec<DVec3> = (0..state.len())
+        .filter(|&i| state.bodies[i].half_length > 0.0)
+        .map(|i| state.axis(i))
+        .collect();
     *obs = PackingObservables {
         step: clock.step,
         packing_fraction: state.packing_fraction(),
