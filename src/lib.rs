@@ -11,6 +11,8 @@
 //! println!("{}", summary["packing_fraction"]);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod bench;
 pub mod chart;
 pub mod replay;

@@ -10,6 +10,8 @@
 //! assert_eq!(shape.radius(), 0.5);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod clock;
 pub mod container;
 pub mod forces;

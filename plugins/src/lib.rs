@@ -9,6 +9,8 @@
 //! * [`packing`]: the `packing` pipeline.
 //! * [`recorder`] and [`record`]: recordings.
 
+#![warn(missing_docs)]
+
 pub mod app;
 pub mod core;
 pub mod group;

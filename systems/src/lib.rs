@@ -10,6 +10,8 @@
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod clock;
 pub mod forces;
