@@ -68,10 +68,12 @@ fn long_rods_small_follow_the_random_contact_equation_roughly() {
 }
 
 #[test]
-#[ignore = "validation tier (release): N = 300 rods of aspect ratio 25 and 30"]
+#[ignore = "validation tier (release): N = 500 rods of aspect ratio 25 (thesis size)"]
 fn long_rods_random_contact_equation() {
-    for aspect in [25.0, 30.0] {
-        let r = run(300, rod(aspect), 1, |c| c.initial_packing_fraction = 0.01);
+    // N = 500 as in the thesis: with N = 300 the box (32 D) is barely longer than a rod and
+    // phi (aspect - 1) drops to 4.3
+    for aspect in [25.0] {
+        let r = run(500, rod(aspect), 1, |c| c.initial_packing_fraction = 0.01);
         let rc = r.packing_fraction * (aspect - 1.0);
         assert!(
             (rc - 5.0).abs() <= 0.5,
