@@ -6,6 +6,7 @@
 //! * [`sets`]: [`sets::SimSchedule`], the chained [`sets::SimSystems`] and [`sets::ForceSystems`].
 //! * [`forces`]: fixed-order accumulation of per-contribution force components.
 //! * [`geometry`]: volumes, inertia, segment distances.
+//! * [`field`]: magnetic fields, gradients and forces of magnetised cylinders.
 //! * [`packing`]: the mechanical contraction method.
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
@@ -14,6 +15,7 @@
 
 pub mod analysis;
 pub mod clock;
+pub mod field;
 pub mod forces;
 pub mod geometry;
 pub mod packing;
