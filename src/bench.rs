@@ -106,7 +106,8 @@ fn loose_spheres(
     Ok((state, list))
 }
 
-fn emit(rows: &mut Vec<Value>, as_json: bool, row: Value) {
+/// Print one measurement (JSON line or a table row) and keep it.
+pub(crate) fn emit(rows: &mut Vec<Value>, as_json: bool, row: Value) {
     if as_json {
         println!("{row}");
     } else {
@@ -142,9 +143,12 @@ pub fn log_slope(points: &[(f64, f64)]) -> f64 {
 /// # Errors
 /// [`BenchError::Input`] for an unknown target.
 pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
+    if what == "field" {
+        return crate::bench_field::bench_field(as_json, quick);
+    }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown benchmark `{what}`; available: packing"
+            "unknown benchmark `{what}`; available: packing, field"
         )));
     }
     let threads = rayon::current_num_threads();
@@ -235,9 +239,17 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
 /// # Errors
 /// [`BenchError::Input`] for an unknown chart, [`BenchError::Runtime`] for I/O.
 pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
+    if what == "field" {
+        let rows = crate::bench_field::chart_field(out, quick)?;
+        println!(
+            "{}",
+            json!({"charts": [out.join("field_error_vs_cost.svg").display().to_string()], "points": rows})
+        );
+        return Ok(());
+    }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown chart `{what}`; available: packing"
+            "unknown chart `{what}`; available: packing, field"
         )));
     }
     std::fs::create_dir_all(out)

@@ -14,7 +14,9 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod bench_field;
 pub mod chart;
+pub mod fieldtool;
 pub mod replay;
 pub mod scene;
 pub mod sim;

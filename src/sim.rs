@@ -8,7 +8,7 @@ use magsep_components::prelude::*;
 use magsep_plugins::app::SimApp;
 use magsep_plugins::group::PipelineGroup;
 use magsep_plugins::packing::packing_pipeline;
-use magsep_plugins::record::{RecordError, RecordingMetadata, RecordingWriter};
+use magsep_plugins::record::{FibreShape, RecordError, RecordingMetadata, RecordingWriter};
 use magsep_plugins::recorder::Recorder;
 
 use crate::scene::{RecordEvery, Scene, SpawnError, spawn_scene};
@@ -26,6 +26,9 @@ pub enum SimError {
     /// The recording could not be written.
     #[error("recording failed: {0}")]
     Record(#[from] RecordError),
+    /// The scene has no `[simulation]` (a field-only scene: use `magsep field`).
+    #[error("the scene has no [simulation] to run (a field-only scene: use `magsep field`)")]
+    NothingToRun,
     /// A numerical failure was reported.
     #[error("numerical failure: {0}")]
     Health(String),
@@ -69,7 +72,10 @@ impl Simulation {
     /// # Errors
     /// [`SimError`] when spawning, building the schedule or opening the recording fails.
     pub fn from_scene(scene: &Scene, options: RunOptions) -> Result<Self, SimError> {
-        let seed = options.seed.unwrap_or(scene.simulation.seed);
+        let Some(simulation) = &scene.simulation else {
+            return Err(SimError::NothingToRun);
+        };
+        let seed = options.seed.unwrap_or(simulation.seed);
         let mut app = SimApp::new();
         if options.single_threaded {
             app.schedule
@@ -88,7 +94,19 @@ impl Simulation {
                 schedule: app.resolved_schedule(),
                 dt: app.world.resource::<StepClock>().dt,
             };
-            let writer = RecordingWriter::create(path, &meta)?;
+            let mut writer = RecordingWriter::create(path, &meta)?;
+            let (sources, _, _) = scene.field_sources();
+            writer.set_fibres(
+                sources
+                    .iter()
+                    .map(|s| FibreShape {
+                        center: s.center,
+                        axis: s.axis(),
+                        radius: s.radius,
+                        half_length: s.half_length,
+                    })
+                    .collect(),
+            );
             let every = app
                 .world
                 .get_resource::<RecordEvery>()

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+mod field;
 mod info;
 mod run;
 
@@ -82,9 +83,46 @@ enum Command {
         /// MCAP recording.
         recording: PathBuf,
     },
-    /// Benchmarks (`magsep bench packing`).
+    /// Magnetic field of a scene's fibres: CSV at points, or a map in a plane.
+    ///
+    /// `--points FILE.csv` (header `x,y,z` [m]) writes `x,y,z,bx,by,bz` [m, T] to stdout, plus
+    /// the nine `dbi_dj` [T/m] with `--gradient`. `--slice z=0 --extent X0,X1,Y0,Y1 --out
+    /// map.svg` draws |B|, or with `--moment` the attractive force on a particle with the
+    /// capture contour at `--cutoff`.
+    Field {
+        /// Scene file (TOML) with [[fibres]] and/or [external_field].
+        scene: PathBuf,
+        /// Points CSV with header `x,y,z` [m].
+        #[arg(long)]
+        points: Option<PathBuf>,
+        /// Also write the gradient of B (nine columns, T/m).
+        #[arg(long)]
+        gradient: bool,
+        /// Map plane, e.g. `z=0` [m].
+        #[arg(long)]
+        slice: Option<String>,
+        /// Map extent of the two in-plane axes: MIN1,MAX1,MIN2,MAX2 [m].
+        #[arg(long, allow_hyphen_values = true)]
+        extent: Option<String>,
+        /// Map output (SVG).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Cells per side of the map.
+        #[arg(long, default_value_t = 200)]
+        resolution: usize,
+        /// Map the attractive force on a particle with this saturated moment [A m²].
+        #[arg(long)]
+        moment: Option<f64>,
+        /// Capture cut-off force [N] (thesis: 0.5e-15 N).
+        #[arg(long, default_value_t = 0.5e-15)]
+        cutoff: f64,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Benchmarks (`magsep bench packing`, `magsep bench field`).
     Bench {
-        /// What to benchmark: packing.
+        /// What to benchmark: packing or field.
         what: String,
         /// One JSON object per measurement on stdout.
         #[arg(long)]
@@ -95,7 +133,7 @@ enum Command {
     },
     /// Charts as SVG (`magsep chart packing --out DIR`).
     Chart {
-        /// Which chart family: packing.
+        /// Which chart family: packing or field.
         what: String,
         /// Output directory.
         #[arg(long, default_value = "charts")]
@@ -125,6 +163,30 @@ pub fn main() -> i32 {
             threads,
         } => run::run(&scene, record, seed, quiet, threads),
         Command::Validate { scene } => run::validate(&scene),
+        Command::Field {
+            scene,
+            points,
+            gradient,
+            slice,
+            extent,
+            out,
+            resolution,
+            moment,
+            cutoff,
+            threads,
+        } => run::set_threads(threads).and_then(|_| {
+            field::field(field::FieldArgs {
+                scene,
+                points,
+                gradient,
+                slice,
+                extent,
+                out,
+                resolution,
+                moment,
+                cutoff,
+            })
+        }),
         Command::Info { recording, json } => info::info(&recording, json),
         Command::Replay { recording } => info::replay(&recording),
         Command::Bench { what, json, quick } => {

@@ -28,7 +28,13 @@ pub fn validate(path: &Path) -> Result<(), CliError> {
         .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
     println!(
         "{}",
-        serde_json::json!({"valid": true, "scene": path.display().to_string(), "pipeline": "packing", "particles": scene.total_particles()})
+        serde_json::json!({
+            "valid": true,
+            "scene": path.display().to_string(),
+            "pipeline": scene.simulation.as_ref().map(|s| s.pipeline),
+            "particles": scene.total_particles(),
+            "fibres": scene.fibres.len(),
+        })
     );
     Ok(())
 }
@@ -49,8 +55,10 @@ pub fn run(
         pipeline: None,
         single_threaded: single,
     };
-    let mut sim =
-        Simulation::from_scene(&scene, options).map_err(|e| CliError::runtime(e.to_string()))?;
+    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| match e {
+        magsep::sim::SimError::NothingToRun => CliError::input(e.to_string()),
+        e => CliError::runtime(e.to_string()),
+    })?;
     let bar = if quiet {
         ProgressBar::hidden()
     } else {

@@ -16,6 +16,7 @@
 //! assert_eq!(errors.0[0].path, "particles[0].shape.radius");
 //! ```
 
+mod fibres;
 mod sections;
 mod spawn;
 #[cfg(test)]
@@ -27,6 +28,7 @@ use std::path::Path;
 
 use bevy_ecs::prelude::*;
 
+pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use sections::{
     ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec,
     SimulationSection,
@@ -119,10 +121,14 @@ impl SceneRegistry {
 pub struct Scene {
     /// The file's text, verbatim (recorded in the recording's metadata).
     pub text: String,
-    /// `[simulation]`.
-    pub simulation: SimulationSection,
-    /// `[container]`.
-    pub container: ContainerSpec,
+    /// `[simulation]` (absent in a field-only scene).
+    pub simulation: Option<SimulationSection>,
+    /// `[container]` (absent in a field-only scene).
+    pub container: Option<ContainerSpec>,
+    /// `[[fibres]]`, in file order.
+    pub fibres: Vec<FibreSpec>,
+    /// `[external_field]`.
+    pub external_field: Option<ExternalFieldSection>,
     /// `[[particles]]`, in file order (particle ids follow this order).
     pub particles: Vec<ParticleGroup>,
     /// `[packing]` (all keys optional).
@@ -134,7 +140,15 @@ pub struct Scene {
 }
 
 /// The core top-level keys.
-pub const CORE_KEYS: &[&str] = &["simulation", "container", "particles", "packing", "record"];
+pub const CORE_KEYS: &[&str] = &[
+    "simulation",
+    "container",
+    "particles",
+    "packing",
+    "record",
+    "fibres",
+    "external_field",
+];
 
 /// Parse and validate a scene; every problem is reported.
 ///
@@ -156,4 +170,23 @@ pub fn load_scene(path: &Path, registry: &SceneRegistry) -> Result<Scene, SceneE
         )])
     })?;
     parse_scene(&text, registry)
+}
+
+impl Scene {
+    /// The field sources of `[[fibres]]` (magnetisation resolved against the external field),
+    /// the external flux density [T] and the field tolerance.
+    pub fn field_sources(&self) -> (Vec<magsep_systems::field::CylinderSource>, glam::DVec3, f64) {
+        let (b_ext, tol) = self
+            .external_field
+            .as_ref()
+            .map(|e| (e.flux_density(), e.tolerance()))
+            .unwrap_or((glam::DVec3::ZERO, magsep_systems::field::EXACT));
+        let sources = self.fibres.iter().map(|f| f.source(b_ext)).collect();
+        (sources, b_ext, tol)
+    }
+
+    /// Whether this is a field-only scene (fibres and an external field, nothing to run).
+    pub fn is_field_only(&self) -> bool {
+        self.simulation.is_none()
+    }
 }

@@ -195,3 +195,78 @@ fn every_shipped_scene_is_valid() {
     }
     assert!(n >= 4);
 }
+
+#[test]
+fn fibre_scenes_parse_and_report_every_error() {
+    let ok = r#"
+[external_field]
+flux_density = [1.0, 0.0, 0.0]
+[[fibres]]
+kind = "cylinder"
+radius = 3e-4
+half_length = 6e-3
+axis = [1.0, 0.0, 1.0]
+saturation_magnetisation = 985e3
+"#;
+    let scene = parse_scene(ok, &SceneRegistry::default()).unwrap();
+    assert!(scene.is_field_only() && scene.fibres.len() == 1);
+    let (sources, b, tol) = scene.field_sources();
+    assert_eq!((b, tol), (glam::DVec3::X, magsep_systems::field::EXACT));
+    // Stoner-Wohlfarth: L/D = 20 at α = 45° gives θ ≈ 30.3° from the axis (spec 2.6)
+    let m = sources[0].magnetisation;
+    let theta = m
+        .angle_between(glam::DVec3::new(1.0, 0.0, 1.0))
+        .to_degrees();
+    assert!(
+        (m.length() - 985e3).abs() < 1e-6 && (theta - 30.3).abs() < 0.2,
+        "{theta}"
+    );
+    let bad = r#"
+[external_field]
+flux_density = [0.0, 0.0, 0.0]
+field_tolerance = 2.0
+[[fibres]]
+kind = "cylinder"
+radius = -1.0
+half_length = 1.0
+axis = [0.0, 0.0, 0.0]
+[[fibres]]
+kind = "cylinder"
+radius = 1.0
+half_length = 1.0
+axis = [0.0, 0.0, 1.0]
+magnetisation = [1.0, 0.0, 0.0]
+saturation_magnetisation = 1.0
+[[fibres]]
+kind = "cylinder"
+radius = 1.0
+half_length = 1.0
+axis = [0.0, 0.0, 1.0]
+saturation_magnetisation = 1.0
+[[fibres]]
+kind = "cube"
+"#;
+    let errs = parse_scene(bad, &SceneRegistry::default()).unwrap_err().0;
+    let paths: Vec<&str> = errs.iter().map(|e| e.path.as_str()).collect();
+    for want in [
+        "external_field.field_tolerance",
+        "fibres[0].radius",
+        "fibres[0].axis",
+        "fibres[0].magnetisation",
+        "fibres[1].magnetisation",
+        "fibres[2].saturation_magnetisation",
+        "fibres[3]",
+    ] {
+        assert!(
+            paths.iter().any(|p| p.starts_with(want)),
+            "{want} missing in {paths:?}"
+        );
+    }
+    // fibres next to particles need the run tables as usual
+    let mixed =
+        format!("{ok}\n[[particles]]\ncount = 2\nshape = {{ kind = \"sphere\", radius = 1.0 }}\n");
+    let errs = parse_scene(&mixed, &SceneRegistry::default())
+        .unwrap_err()
+        .0;
+    assert!(errs.iter().any(|e| e.path == "simulation"));
+}

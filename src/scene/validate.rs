@@ -2,6 +2,7 @@
 
 use serde::de::DeserializeOwned;
 
+use super::fibres::{ExternalFieldSection, FibreSpec, validate_fibres};
 use super::sections::*;
 use super::{CORE_KEYS, Scene, SceneError, SceneRegistry};
 
@@ -114,6 +115,8 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut packing = PackingSection::default();
     let mut record = None;
     let mut extensions = Vec::new();
+    let mut fibres = Vec::new();
+    let mut external_field = None;
     for (key, value) in &table {
         match key.as_str() {
             "simulation" => {
@@ -124,6 +127,27 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 packing = typed::<PackingSection>(value, "packing", &mut errors).unwrap_or_default()
             }
             "record" => record = typed::<RecordSection>(value, "record", &mut errors),
+            "external_field" => {
+                external_field = typed::<ExternalFieldSection>(value, "external_field", &mut errors)
+            }
+            "fibres" => match value {
+                toml::Value::Array(items) => {
+                    for (i, item) in items.iter().enumerate() {
+                        if let Some(f) =
+                            typed::<FibreSpec>(item, &format!("fibres[{i}]"), &mut errors)
+                        {
+                            fibres.push((i, f));
+                        }
+                    }
+                }
+                other => errors.push(SceneError::new(
+                    "fibres",
+                    format!(
+                        "must be an array of tables ([[fibres]]), got a {}",
+                        other.type_str()
+                    ),
+                )),
+            },
             "particles" => match value {
                 toml::Value::Array(items) => {
                     for (i, item) in items.iter().enumerate() {
@@ -158,13 +182,18 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             },
         }
     }
-    if !table.contains_key("simulation") {
+    // a scene with nothing but fibres and an external field is a field-only scene
+    let field_only = !table.contains_key("simulation")
+        && !table.contains_key("particles")
+        && !table.contains_key("container")
+        && (table.contains_key("fibres") || table.contains_key("external_field"));
+    if !field_only && !table.contains_key("simulation") {
         errors.push(SceneError::new(
             "simulation",
             "missing required table [simulation]",
         ));
     }
-    if !table.contains_key("container") {
+    if !field_only && !table.contains_key("container") {
         errors.push(SceneError::new(
             "container",
             "missing required table [container]",
@@ -260,16 +289,23 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             format!("must be >= 1, got {}", r.every)
         });
     }
+    validate_fibres(&fibres, external_field.as_ref(), &mut errors);
     match (simulation, container, errors.is_empty()) {
-        (Some(simulation), Some(container), true) => Ok(Scene {
-            text: text.to_string(),
-            simulation,
-            container,
-            particles: particles.into_iter().map(|(_, g)| g).collect(),
-            packing,
-            record,
-            extensions,
-        }),
+        (simulation, container, true)
+            if field_only || (simulation.is_some() && container.is_some()) =>
+        {
+            Ok(Scene {
+                text: text.to_string(),
+                simulation,
+                container,
+                fibres: fibres.into_iter().map(|(_, f)| f).collect(),
+                external_field,
+                particles: particles.into_iter().map(|(_, g)| g).collect(),
+                packing,
+                record,
+                extensions,
+            })
+        }
         _ => Err(errors),
     }
 }

@@ -31,6 +31,19 @@ pub struct ParticleFrame {
     pub status_json: String,
 }
 
+/// A magnetised fibre as drawn in the Foxglove scene (entity `fibres`): a cylinder.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FibreShape {
+    /// Centre \[m\].
+    pub center: DVec3,
+    /// Axis direction (unit).
+    pub axis: DVec3,
+    /// Radius \[m\].
+    pub radius: f64,
+    /// Half length \[m\].
+    pub half_length: f64,
+}
+
 /// Metadata written once at the start of a recording (MCAP metadata record `magsep`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct RecordingMetadata {

@@ -1,6 +1,6 @@
 //! The `/scene` channel: one `foxglove.SceneUpdate` per frame.
 
-use super::{ParticleFrame, SCENE_FRAME_ID};
+use super::{FibreShape, ParticleFrame, SCENE_FRAME_ID};
 use foxglove::messages::{
     Color, CylinderPrimitive, Duration, LinePrimitive, Point3, Pose, Quaternion, SceneEntity,
     SceneUpdate, SpherePrimitive, Timestamp, Vector3, line_primitive,
@@ -79,13 +79,20 @@ pub(crate) fn box_edge_points(e: DVec3) -> Vec<Point3> {
     points
 }
 
+/// Id of the fibres entity.
+pub const FIBRES_ENTITY: &str = "fibres";
+/// Colour of fibres (steel grey).
+const FIBRE_COLOUR: [f32; 4] = [0.55, 0.57, 0.62, 1.0];
+
 /// Builds the scene of `frame`: entity `particles` (a sphere of diameter 2R per sphere;
-/// a cylinder of size (2R, 2R, 2h) plus two end spheres per capsule) and entity `box`.
+/// a cylinder of size (2R, 2R, 2h) plus two end spheres per capsule), entity `box`, and entity
+/// `fibres` (one cylinder per fibre) when there are fibres.
 ///
 /// `frame`'s arrays must have equal lengths; `colours`, if given, one entry per particle.
 pub(crate) fn scene_update(
     frame: &ParticleFrame,
     colours: Option<&[[f32; 4]]>,
+    fibres: &[FibreShape],
     log_time_ns: u64,
 ) -> SceneUpdate {
     let stamp = timestamp(log_time_ns);
@@ -147,8 +154,32 @@ pub(crate) fn scene_update(
         }],
         ..entity(BOX_ENTITY)
     };
+    let mut entities = vec![particles, outline];
+    if !fibres.is_empty() {
+        entities.push(SceneEntity {
+            cylinders: fibres
+                .iter()
+                .map(|f| CylinderPrimitive {
+                    // Foxglove cylinders have their axis along local z
+                    pose: pose(
+                        f.center,
+                        DQuat::from_rotation_arc(DVec3::Z, f.axis.normalize()),
+                    ),
+                    size: Some(vec3(DVec3::new(
+                        2.0 * f.radius,
+                        2.0 * f.radius,
+                        2.0 * f.half_length,
+                    ))),
+                    bottom_scale: 1.0,
+                    top_scale: 1.0,
+                    color: colour(FIBRE_COLOUR),
+                })
+                .collect(),
+            ..entity(FIBRES_ENTITY)
+        });
+    }
     SceneUpdate {
         deletions: Vec::new(),
-        entities: vec![particles, outline],
+        entities,
     }
 }

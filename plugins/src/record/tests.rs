@@ -363,7 +363,7 @@ fn record_scene_geometry_of_spheres_capsules_and_box() {
         status_json: "{}".into(),
     };
     let colours = [[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 0.5]];
-    let s = scene::scene_update(&frame, Some(&colours), 4);
+    let s = scene::scene_update(&frame, Some(&colours), &[], 4);
     let p = &s.entities[0];
     let size = |v: &Option<foxglove::messages::Vector3>| {
         let v = v.unwrap();

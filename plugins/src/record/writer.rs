@@ -1,5 +1,6 @@
 //! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame.
 
+use super::frame::FibreShape;
 use super::proto::{ParticleState, particle_count, state_schema};
 use super::scene::scene_update;
 use super::{
@@ -59,6 +60,8 @@ pub struct RecordingWriter {
     last_log_time: Option<u64>,
     /// Reused message encoding buffer.
     buf: Vec<u8>,
+    /// Fibres drawn in every scene update.
+    fibres: Vec<FibreShape>,
 }
 
 impl RecordingWriter {
@@ -84,6 +87,7 @@ impl RecordingWriter {
             frames_written: 0,
             last_log_time: None,
             buf: Vec::new(),
+            fibres: Vec::new(),
         };
         let mut mcap = options
             .create(BufWriter::new(file))
@@ -173,7 +177,7 @@ impl RecordingWriter {
         self.write_message(self.state_channel, sequence, log_time)?;
 
         self.buf.clear();
-        scene_update(frame, colours, log_time)
+        scene_update(frame, colours, &self.fibres, log_time)
             .encode(&mut self.buf)
             .map_err(|e| RecordError::InvalidInput {
                 detail: format!("encoding /scene: {e}"),
@@ -184,6 +188,11 @@ impl RecordingWriter {
         self.last_log_time = Some(log_time);
         self.frames_written += 1;
         Ok(())
+    }
+
+    /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
+    pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
+        self.fibres = fibres;
     }
 
     /// Writes the metadata record [`SUMMARY_METADATA_NAME`] with key `summary` = `summary_json`

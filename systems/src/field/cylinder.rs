@@ -41,7 +41,7 @@
 
 use std::f64::consts::PI;
 
-use super::cel::cel_cylinder;
+use super::cel::cel_cylinder_pair;
 use super::real::Real;
 
 /// Below `ρ = AXIS_SWITCH · R` the near-axis expansion is used.
@@ -109,18 +109,21 @@ pub fn closed_form<T: Real>(rho: T, z: T, radius: f64, half_length: f64, chi: f6
     let sp = rho + radius;
     let dm = rho - radius;
     let gamma = dm / sp;
-    let mut psi_rz = T::cst(0.0);
-    let mut bz = T::cst(0.0);
-    let mut p3 = T::cst(0.0);
-    for (xi, sign) in [(z + half_length, 1.0), (z - half_length, -1.0)] {
-        let alpha = (xi * xi + sp * sp).sqrt().recip();
-        let beta = xi * alpha;
-        let kc = (xi * xi + dm * dm).sqrt() * alpha;
-        let [p1, xk, p2, yk] = cel_cylinder(kc, gamma);
-        psi_rz = psi_rz + alpha * p1 * sign;
-        bz = bz + beta * p2 * sign;
-        p3 = p3 + beta * (xk - gamma * gamma * yk) * sign;
-    }
+    let xi = [z + half_length, z - half_length];
+    let alpha = [
+        (xi[0] * xi[0] + sp * sp).sqrt().recip(),
+        (xi[1] * xi[1] + sp * sp).sqrt().recip(),
+    ];
+    let kc = [
+        (xi[0] * xi[0] + dm * dm).sqrt() * alpha[0],
+        (xi[1] * xi[1] + dm * dm).sqrt() * alpha[1],
+    ];
+    let [[p1a, xa, p2a, ya], [p1b, xb, p2b, yb]] = cel_cylinder_pair(kc, gamma);
+    let (beta_a, beta_b) = (xi[0] * alpha[0], xi[1] * alpha[1]);
+    let g2 = gamma * gamma;
+    let psi_rz = alpha[0] * p1a - alpha[1] * p1b;
+    let bz = beta_a * p2a - beta_b * p2b;
+    let p3 = beta_a * (xa - g2 * ya) - beta_b * (xb - g2 * yb);
     let psi_rz = psi_rz * (radius / PI);
     let pzz = bz * radius / (sp * PI) - chi;
     let b = -(p3 * radius / (rho * PI));

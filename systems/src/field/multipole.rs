@@ -64,14 +64,84 @@ pub fn truncation_bound(order: usize, x: f64) -> f64 {
     }
 }
 
-/// Smallest even order whose [`truncation_bound`] at `x = a/r` is within `tol`, if any.
-pub fn order_for(x: f64, tol: f64) -> Option<usize> {
+/// A closed-form majorant of [`truncation_bound`]: with `m = order + 2`,
+/// `(m+2k+1)(m+2k+2)(m+2k+3) ≤ (m+1)(m+2)(m+3)(k+1)³ ≤ 6 (m+1)(m+2)(m+3) C(k+3, 3)`, so the
+/// bound is at most `6 (m+1)(m+2)(m+3) xᵐ / (1 - x²)⁴`.
+pub fn truncation_majorant(order: usize, x: f64) -> f64 {
     if x >= 1.0 {
+        return f64::INFINITY;
+    }
+    let m = (order + 2) as f64;
+    6.0 * (m + 1.0) * (m + 2.0) * (m + 3.0) * x.powf(m) / (1.0 - x * x).powi(4)
+}
+
+/// Smallest even order whose [`truncation_majorant`] at `x = a/r` is within `tol`, if any
+/// (a few logarithms: cheap enough to decide per point).
+pub fn order_for(x: f64, tol: f64) -> Option<usize> {
+    if !(x < 1.0) || !(tol > 0.0) {
         return None;
     }
-    (0..=MAX_ORDER)
-        .step_by(2)
-        .find(|&n| truncation_bound(n, x) <= tol)
+    if x <= 0.0 {
+        return Some(0);
+    }
+    let c = (6.0 / (tol * (1.0 - x * x).powi(4))).ln();
+    let lx = -x.ln();
+    // fixed point of m = (c + ln((m+1)(m+2)(m+3))) / ln(1/x), from below
+    let mut m = (c / lx).max(2.0);
+    for _ in 0..8 {
+        let next = (c + ((m + 1.0) * (m + 2.0) * (m + 3.0)).ln()) / lx;
+        if next <= m {
+            break;
+        }
+        m = next;
+    }
+    let mut m = (m.ceil() as usize).max(2);
+    m += m % 2;
+    let order = m - 2;
+    if order > MAX_ORDER {
+        return None;
+    }
+    // the iteration may overshoot by one step: take the smaller order if it already qualifies
+    if order >= 2 && truncation_majorant(order - 2, x) <= tol {
+        return Some(order - 2);
+    }
+    Some(order)
+}
+
+/// Largest `x = a/r` at which some order up to [`MAX_ORDER`] meets `tol`, conservatively
+/// (from a table at decades of the tolerance, rounded down to the decade): a cheap test that
+/// rules the expansion out for near points before [`order_for`] is called.
+pub fn x_limit(tol: f64) -> f64 {
+    static TABLE: std::sync::OnceLock<[f64; 16]> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        let mut t = [0.0; 16];
+        for (i, v) in t.iter_mut().enumerate() {
+            let tol = 10f64.powi(-15 + i as i32);
+            // bisection on the monotone majorant at the highest order
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if truncation_majorant(MAX_ORDER, mid) <= tol {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            *v = lo;
+        }
+        t
+    });
+    if !(tol >= 1e-15) {
+        return 0.0;
+    }
+    // index of the largest decade <= tol (no logarithm on the hot path)
+    let mut i = 0;
+    let mut decade = 1e-15;
+    while i < 15 && decade * 10.0 <= tol * (1.0 + 1e-12) {
+        decade *= 10.0;
+        i += 1;
+    }
+    table[i]
 }
 
 /// `H = Hess(Ψ) · m` from the expansion through `order` (even) at a body-frame point outside
@@ -173,5 +243,20 @@ mod tests {
             last = n;
         }
         assert!(truncation_bound(4, 0.1) < truncation_bound(2, 0.1));
+        // the majorant bounds the series, and the chosen order is the smallest that meets tol
+        for x in [0.01, 0.1, 0.3, 0.6, 0.9] {
+            for n in [0, 2, 10, 40] {
+                assert!(truncation_majorant(n, x) >= truncation_bound(n, x));
+            }
+            for tol in [1e-3, 1e-9, 1e-15] {
+                if let Some(n) = order_for(x, tol) {
+                    assert!(truncation_majorant(n, x) <= tol, "{x} {tol} {n}");
+                    assert!(
+                        n == 0 || truncation_majorant(n - 2, x) > tol,
+                        "{x} {tol} {n}"
+                    );
+                }
+            }
+        }
     }
 }

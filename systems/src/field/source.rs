@@ -96,8 +96,14 @@ impl CylinderSource {
     /// about two circumradii, where the closed form starts to lose digits to the cancellation
     /// of its two end terms).
     pub fn multipole_order(&self, p: DVec3, tol: f64) -> Option<usize> {
-        let r = (p - self.center).length();
-        multipole::order_for(self.circumradius / r, tol.max(EXACT))
+        let tol = tol.max(EXACT);
+        let r2 = (p - self.center).length_squared();
+        let xl = multipole::x_limit(tol);
+        // cheap rejection of near points: a/r > x_limit
+        if self.circumradius * self.circumradius >= xl * xl * r2 {
+            return None;
+        }
+        multipole::order_for(self.circumradius / r2.sqrt(), tol)
     }
 
     /// Body-frame `H` (generic: `f64` or [`Dual3`]) and `χ`.
