@@ -78,7 +78,7 @@ pub fn truncation_majorant(order: usize, x: f64) -> f64 {
 /// Smallest even order whose [`truncation_majorant`] at `x = a/r` is within `tol`, if any
 /// (a few logarithms: cheap enough to decide per point).
 pub fn order_for(x: f64, tol: f64) -> Option<usize> {
-    if !(x < 1.0) || !(tol > 0.0) {
+    if x.is_nan() || x >= 1.0 || tol.is_nan() || tol <= 0.0 {
         return None;
     }
     if x <= 0.0 {
@@ -131,7 +131,7 @@ pub fn x_limit(tol: f64) -> f64 {
         }
         t
     });
-    if !(tol >= 1e-15) {
+    if tol.is_nan() || tol < 1e-15 {
         return 0.0;
     }
     // index of the largest decade <= tol (no logarithm on the hot path)
