@@ -37,6 +37,7 @@
 #![warn(missing_docs)]
 
 mod data;
+mod heatmap;
 mod legend;
 mod render;
 mod svg;
@@ -47,6 +48,7 @@ mod tests;
 
 use std::path::Path;
 
+pub use heatmap::{ColourScale, Heatmap};
 pub use svg::escape_xml;
 
 /// Default colour palette (Okabe-Ito, colour-blind friendly), in the order
