@@ -181,14 +181,14 @@ fn closed_only(src: &CylinderSource, p: DVec3) -> DVec3 {
     e1 * h[0] + e2 * h[1] + DVec3::Z * h[2]
 }
 
-/// Multipole through `order` (world = body frame up to e1, as in [`closed_only`]).
-fn multipole_only(src: &CylinderSource, p: DVec3, order: usize) -> DVec3 {
+/// Multipole through `order` with precomputed coefficients `q` (world = body frame up to e1,
+/// as in [`closed_only`]).
+fn multipole_only(q: &[f64], src: &CylinderSource, p: DVec3, order: usize) -> DVec3 {
     let e1 = DVec3::Z.any_orthonormal_vector();
     let e2 = DVec3::Z.cross(e1);
-    let q = multipole::coefficients(src.radius, src.half_length);
     let m = src.magnetisation;
     let h = multipole::field(
-        &q,
+        q,
         order,
         [p.dot(e1), p.dot(e2), p.z],
         [m.dot(e1), m.dot(e2), m.z],
@@ -208,20 +208,24 @@ pub fn chart_field(out: &Path, quick: bool) -> Result<Vec<Value>, BenchError> {
     };
     let samples = if quick { 50 } else { 400 };
     type Method = Box<dyn Fn(&CylinderSource, DVec3) -> DVec3>;
+    let q: &'static [f64] = Box::leak(multipole::coefficients(RADIUS, 3.0).into_boxed_slice());
     let methods: Vec<(String, Method)> = vec![
         ("exact closed form".into(), Box::new(closed_only)),
-        ("dipole".into(), Box::new(|s, p| multipole_only(s, p, 0))),
+        (
+            "dipole".into(),
+            Box::new(move |s, p| multipole_only(q, s, p, 0)),
+        ),
         (
             "multipole N=2".into(),
-            Box::new(|s, p| multipole_only(s, p, 2)),
+            Box::new(move |s, p| multipole_only(q, s, p, 2)),
         ),
         (
             "multipole N=6".into(),
-            Box::new(|s, p| multipole_only(s, p, 6)),
+            Box::new(move |s, p| multipole_only(q, s, p, 6)),
         ),
         (
             "multipole N=16".into(),
-            Box::new(|s, p| multipole_only(s, p, 16)),
+            Box::new(move |s, p| multipole_only(q, s, p, 16)),
         ),
         (
             "auto, tolerance 1e-6".into(),

@@ -75,37 +75,22 @@ pub fn truncation_majorant(order: usize, x: f64) -> f64 {
     6.0 * (m + 1.0) * (m + 2.0) * (m + 3.0) * x.powf(m) / (1.0 - x * x).powi(4)
 }
 
-/// Smallest even order whose [`truncation_majorant`] at `x = a/r` is within `tol`, if any
-/// (a few logarithms: cheap enough to decide per point).
+/// Smallest even order whose [`truncation_majorant`] at `x = a/r` is within `tol`, if any.
 pub fn order_for(x: f64, tol: f64) -> Option<usize> {
     if x.is_nan() || x >= 1.0 || tol.is_nan() || tol <= 0.0 {
         return None;
     }
-    if x <= 0.0 {
-        return Some(0);
-    }
-    let c = (6.0 / (tol * (1.0 - x * x).powi(4))).ln();
-    let lx = -x.ln();
-    // fixed point of m = (c + ln((m+1)(m+2)(m+3))) / ln(1/x), from below
-    let mut m = (c / lx).max(2.0);
-    for _ in 0..8 {
-        let next = (c + ((m + 1.0) * (m + 2.0) * (m + 3.0)).ln()) / lx;
-        if next <= m {
-            break;
+    let y = x * x;
+    let c = 6.0 / (1.0 - y).powi(4);
+    let mut xm = y; // x^m, m = order + 2
+    for order in (0..=MAX_ORDER).step_by(2) {
+        let m = (order + 2) as f64;
+        if c * (m + 1.0) * (m + 2.0) * (m + 3.0) * xm <= tol {
+            return Some(order);
         }
-        m = next;
+        xm *= y;
     }
-    let mut m = (m.ceil() as usize).max(2);
-    m += m % 2;
-    let order = m - 2;
-    if order > MAX_ORDER {
-        return None;
-    }
-    // the iteration may overshoot by one step: take the smaller order if it already qualifies
-    if order >= 2 && truncation_majorant(order - 2, x) <= tol {
-        return Some(order - 2);
-    }
-    Some(order)
+    None
 }
 
 /// Largest `x = a/r` at which some order up to [`MAX_ORDER`] meets `tol`, conservatively
@@ -113,7 +98,12 @@ pub fn order_for(x: f64, tol: f64) -> Option<usize> {
 /// rules the expansion out for near points before [`order_for`] is called.
 pub fn x_limit(tol: f64) -> f64 {
     static TABLE: std::sync::OnceLock<[f64; 16]> = std::sync::OnceLock::new();
-    let table = TABLE.get_or_init(|| {
+    x_limit_in(&TABLE, MAX_ORDER, tol)
+}
+
+/// [`x_limit`] for expansions up to order `order` only (a table per `order`).
+fn x_limit_in(cell: &std::sync::OnceLock<[f64; 16]>, order: usize, tol: f64) -> f64 {
+    let table = cell.get_or_init(|| {
         let mut t = [0.0; 16];
         for (i, v) in t.iter_mut().enumerate() {
             let tol = 10f64.powi(-15 + i as i32);
@@ -121,7 +111,7 @@ pub fn x_limit(tol: f64) -> f64 {
             let (mut lo, mut hi) = (0.0, 1.0);
             for _ in 0..60 {
                 let mid = 0.5 * (lo + hi);
-                if truncation_majorant(MAX_ORDER, mid) <= tol {
+                if truncation_majorant(order, mid) <= tol {
                     lo = mid;
                 } else {
                     hi = mid;
@@ -143,6 +133,16 @@ pub fn x_limit(tol: f64) -> f64 {
     }
     table[i]
 }
+
+/// [`x_limit`] for orders up to [`FAST_ORDER`].
+pub fn x_limit_fast(tol: f64) -> f64 {
+    static TABLE: std::sync::OnceLock<[f64; 16]> = std::sync::OnceLock::new();
+    x_limit_in(&TABLE, FAST_ORDER, tol)
+}
+
+/// Highest order used for speed at a loose tolerance: up to here the expansion is cheaper than
+/// the closed form; beyond it is only used where the closed form is the less accurate.
+pub const FAST_ORDER: usize = 16;
 
 /// `H = Hess(Ψ) · m` from the expansion through `order` (even) at a body-frame point outside
 /// the circumscribed sphere. `q` from [`coefficients`].

@@ -92,18 +92,37 @@ impl CylinderSource {
 
     /// Multipole order used at `p` for relative tolerance `tol`, or `None` for the closed form.
     ///
-    /// The expansion is used wherever its error bound is within `tol` (at [`EXACT`]: beyond
-    /// about two circumradii, where the closed form starts to lose digits to the cancellation
-    /// of its two end terms).
+    /// At a loose tolerance the expansion is used wherever an order up to
+    /// [`multipole::FAST_ORDER`] meets it (cheaper than the closed form). Otherwise it is used
+    /// where the closed form's estimated rounding error (its two end terms cancel far away:
+    /// `~1e-16 (r/a)² max(50, r a/R²)`) exceeds 1e-13, at the smallest order meeting `tol`, or
+    /// failing that the closed form's error.
     pub fn multipole_order(&self, p: DVec3, tol: f64) -> Option<usize> {
         let tol = tol.max(EXACT);
         let r2 = (p - self.center).length_squared();
-        let xl = multipole::x_limit(tol);
-        // cheap rejection of near points: a/r > x_limit
-        if self.circumradius * self.circumradius >= xl * xl * r2 {
+        let a2 = self.circumradius * self.circumradius;
+        if a2 >= r2 {
             return None;
         }
-        multipole::order_for(self.circumradius / r2.sqrt(), tol)
+        // a loose tolerance buys speed while the expansion is cheaper than the closed form
+        let xf = multipole::x_limit_fast(tol);
+        if tol > EXACT
+            && a2 < xf * xf * r2
+            && let Some(n) = multipole::order_for(self.circumradius / r2.sqrt(), tol)
+            && n <= multipole::FAST_ORDER
+        {
+            return Some(n);
+        }
+        // the closed form's rounding error from its cancelling end terms (conservative):
+        // ~1e-16 (r/a)² max(50, r a / R²)
+        let r = r2.sqrt();
+        let closed_error =
+            1e-16 * (r2 / a2) * (r * self.circumradius / (self.radius * self.radius)).max(50.0);
+        if closed_error <= tol.max(1e-13) {
+            return None;
+        }
+        let x = self.circumradius / r;
+        multipole::order_for(x, tol).or_else(|| multipole::order_for(x, closed_error))
     }
 
     /// Body-frame `H` (generic: `f64` or [`Dual3`]) and `χ`.
