@@ -14,6 +14,7 @@
 
 pub mod clock;
 pub mod container;
+pub mod fibre;
 pub mod forces;
 pub mod health;
 pub mod packing;
@@ -24,6 +25,7 @@ pub mod shape;
 pub mod prelude {
     pub use crate::clock::StepClock;
     pub use crate::container::Container;
+    pub use crate::fibre::{ExternalField, Fibre, FibreId};
     pub use crate::forces::{ForceContribution, NetForce, NetTorque};
     pub use crate::health::Health;
     pub use crate::packing::{

@@ -89,6 +89,24 @@ pub fn spawn_scene_with(
     world.insert_resource(RecordEvery(
         scene.record.as_ref().map(|r| r.every).unwrap_or(100),
     ));
+    // fibres as entities, and the applied field
+    let (sources, b_ext, tolerance) = scene.field_sources();
+    for (i, s) in sources.iter().enumerate() {
+        world.spawn((
+            FibreId(i as u64),
+            Fibre {
+                center: s.center,
+                axis: s.axis(),
+                radius: s.radius,
+                half_length: s.half_length,
+                magnetisation: s.magnetisation,
+            },
+        ));
+    }
+    world.insert_resource(ExternalField {
+        flux_density: b_ext,
+        tolerance,
+    });
     for (key, value) in &scene.extensions {
         if let Some(kind) = registry.get(key) {
             kind.spawn(value, world)?;

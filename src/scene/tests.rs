@@ -270,3 +270,36 @@ kind = "cube"
         .0;
     assert!(errs.iter().any(|e| e.path == "simulation"));
 }
+
+#[test]
+fn fibres_are_spawned_as_entities_next_to_particles() {
+    let text = r#"
+[simulation]
+pipeline = "packing"
+[container]
+kind = "periodic_box"
+[[particles]]
+count = 4
+shape = { kind = "sphere", radius = 0.5 }
+[external_field]
+flux_density = [0.0, 0.0, 1.0]
+[[fibres]]
+kind = "cylinder"
+radius = 0.1
+half_length = 1.0
+axis = [0.0, 0.0, 2.0]
+magnetisation = [0.0, 0.0, 1e5]
+"#;
+    let scene = parse_scene(text, &SceneRegistry::default()).unwrap();
+    let mut world = bevy_ecs::prelude::World::new();
+    crate::scene::spawn_scene(&scene, &mut world, 1).unwrap();
+    let mut q = world.query::<(
+        &magsep_components::fibre::FibreId,
+        &magsep_components::fibre::Fibre,
+    )>();
+    let fibres: Vec<_> = q.iter(&world).map(|(i, f)| (i.0, *f)).collect();
+    assert_eq!(fibres.len(), 1);
+    assert_eq!(fibres[0].1.axis, glam::DVec3::Z);
+    let ext = world.resource::<magsep_components::fibre::ExternalField>();
+    assert_eq!(ext.flux_density, glam::DVec3::Z);
+}
