@@ -198,44 +198,13 @@ fn clamp_kc<T: Real>(kc: T) -> T {
 mod tests {
     use super::*;
 
-    /// Gauss-Legendre nodes and weights on [-1, 1] (Newton on the Legendre recurrence).
-    pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-        (0..n)
-            .map(|i| {
-                let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-                for _ in 0..100 {
-                    let (mut p0, mut p1) = (1.0, x);
-                    for k in 2..=n {
-                        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                        p0 = p1;
-                        p1 = p2;
-                    }
-                    let dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                    let dx = p1 / dp;
-                    x -= dx;
-                    if dx.abs() < 1e-16 {
-                        break;
-                    }
-                }
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                let dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                (x, 2.0 / ((1.0 - x * x) * dp * dp))
-            })
-            .collect()
-    }
-
     /// The defining integral by Gauss-Legendre on [0, π/2] (smooth for moderate kc, p).
     fn cel_quad(kc: f64, p: f64, a: f64, b: f64) -> f64 {
-        let h = std::f64::consts::FRAC_PI_4;
-        gauss_legendre(200)
+        let h = std::f64::consts::FRAC_PI_2;
+        crate::field::demag::gauss_legendre_01(200)
             .iter()
             .map(|&(x, w)| {
-                let phi = h * (x + 1.0);
+                let phi = h * x;
                 let (s, c) = phi.sin_cos();
                 let (s2, c2) = (s * s, c * c);
                 w * h * (a * c2 + b * s2) / ((c2 + p * s2) * (c2 + kc * kc * s2).sqrt())

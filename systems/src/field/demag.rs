@@ -22,8 +22,8 @@ use glam::DVec3;
 
 use super::source::MU0;
 
-/// Gauss-Legendre nodes and weights on [0, 1].
-fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
+/// Gauss-Legendre nodes and weights on [0, 1] (Newton on the Legendre recurrence).
+pub(crate) fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
     (0..n)
         .map(|i| {
             let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
