@@ -7,7 +7,6 @@
 //! extrapolated to delta = 0 (Wouterse et al. 2007, as in the thesis). Gaps may be negative
 //! (tolerated overlaps) and count as contacts.
 
-use super::super::packing::contact::pair_contact;
 use super::super::packing::neighbour::NeighbourList;
 use super::super::packing::state::PackingState;
 
@@ -39,17 +38,7 @@ pub fn contact_numbers(state: &PackingState) -> ContactNumbers {
     let mut max_overlap: f64 = 0.0;
     let d_min = 1e-8;
     for (i, j, shift) in list.unique_pairs(state.edge) {
-        let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
-        let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(
-            state.axis(i),
-            bi.half_length,
-            bi.radius,
-            r,
-            state.axis(j),
-            bj.half_length,
-            bj.radius,
-        );
+        let c = state.contact(i, j, shift);
         let gap = -c.overlap;
         max_overlap = max_overlap.max(c.overlap);
         gaps.push(gap);

@@ -20,7 +20,6 @@
 
 use glam::{DQuat, DVec3};
 
-use super::contact::pair_contact;
 use super::neighbour::NeighbourList;
 use super::removal::RemovalOutcome;
 use super::state::PackingState;
@@ -58,18 +57,7 @@ pub fn overlap_forces(
     let mut max_overlap: f64 = 0.0;
     let mut energy = 0.0;
     for (i, j, shift) in list.unique_pairs(state.edge) {
-        let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
-        let (ui, uj) = (state.axis(i), state.axis(j));
-        let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(
-            ui,
-            bi.half_length,
-            bi.radius,
-            r,
-            uj,
-            bj.half_length,
-            bj.radius,
-        );
+        let c = state.contact(i, j, shift);
         if c.overlap <= 0.0 {
             continue;
         }
@@ -78,8 +66,9 @@ pub fn overlap_forces(
         let f = c.overlap * c.normal;
         force[i] -= f;
         force[j] += f;
-        let ri = c.s * ui + (bi.radius - 0.5 * c.overlap) * c.normal;
-        let rj = c.t * uj - (bj.radius - 0.5 * c.overlap) * c.normal;
+        let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
+        let ri = c.s * state.axis(i) + (bi.radius - 0.5 * c.overlap) * c.normal;
+        let rj = c.t * state.axis(j) - (bj.radius - 0.5 * c.overlap) * c.normal;
         torque[i] += ri.cross(-f);
         torque[j] += rj.cross(f);
     }

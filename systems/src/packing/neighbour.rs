@@ -266,7 +266,6 @@ impl NeighbourList {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::packing::contact::pair_contact;
     use crate::packing::insert::random_insertion;
     use crate::packing::state::Body;
     use crate::rng::particle_stream;
@@ -287,17 +286,7 @@ mod tests {
                                 continue;
                             }
                             let shift = DVec3::new(a as f64, b as f64, c as f64) * l;
-                            let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
-                            let r = state.positions[j] + shift - state.positions[i];
-                            let pc = pair_contact(
-                                state.axis(i),
-                                bi.half_length,
-                                bi.radius,
-                                r,
-                                state.axis(j),
-                                bj.half_length,
-                                bj.radius,
-                            );
+                            let pc = state.contact(i, j, shift);
                             if -pc.overlap < skin {
                                 out.push((i, j, [a, b, c]));
                             }

@@ -75,17 +75,7 @@ pub fn overlap_scan(
     flags.resize(state.len(), false);
     let mut total = 0.0;
     for (i, j, shift) in list.unique_pairs(state.edge) {
-        let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
-        let r = state.positions[j] + shift - state.positions[i];
-        let c = pair_contact(
-            state.axis(i),
-            bi.half_length,
-            bi.radius,
-            r,
-            state.axis(j),
-            bj.half_length,
-            bj.radius,
-        );
+        let c = state.contact(i, j, shift);
         if c.overlap > 0.0 {
             total += c.overlap;
         }

@@ -10,6 +10,7 @@ use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
 use crate::geometry::{inertia_body_unit_density, volume};
+use crate::packing::contact::{PairContact, pair_contact};
 
 /// Geometry and inertia of one particle, reduced units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,6 +119,21 @@ impl PackingState {
     #[inline]
     pub fn axis(&self, i: usize) -> DVec3 {
         self.orientations[i] * DVec3::Z
+    }
+
+    /// Contact of particles `i` and `j`, with `j` seen through the periodic image `shift`.
+    #[inline]
+    pub fn contact(&self, i: usize, j: usize, shift: DVec3) -> PairContact {
+        let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
+        pair_contact(
+            self.axis(i),
+            bi.half_length,
+            bi.radius,
+            self.positions[j] + shift - self.positions[i],
+            self.axis(j),
+            bj.half_length,
+            bj.radius,
+        )
     }
 
     /// Wrap particle `i` into [0, edge).
