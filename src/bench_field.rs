@@ -6,8 +6,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
-use magsep_systems::field::cylinder::hess_parts;
-use magsep_systems::field::multipole;
 use magsep_systems::field::{CylinderSource, EXACT};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -167,35 +165,6 @@ pub fn far_field_curve(
         .collect()
 }
 
-/// Body-frame H by the closed form only (no multipole).
-fn closed_only(src: &CylinderSource, p: DVec3) -> DVec3 {
-    // the benchmark fibre is axis-aligned at the origin: body frame = world frame up to the
-    // choice of e1; evaluate in a frame with e3 = z
-    let e1 = DVec3::Z.any_orthonormal_vector();
-    let e2 = DVec3::Z.cross(e1);
-    let pb = DVec3::new(p.dot(e1), p.dot(e2), p.z);
-    let m = src.magnetisation;
-    let mb = [m.dot(e1), m.dot(e2), m.z];
-    let parts = hess_parts(pb.x, pb.y, pb.z, src.radius, src.half_length);
-    let h = parts.apply(pb.x, pb.y, mb);
-    e1 * h[0] + e2 * h[1] + DVec3::Z * h[2]
-}
-
-/// Multipole through `order` with precomputed coefficients `q` (world = body frame up to e1,
-/// as in [`closed_only`]).
-fn multipole_only(q: &[f64], src: &CylinderSource, p: DVec3, order: usize) -> DVec3 {
-    let e1 = DVec3::Z.any_orthonormal_vector();
-    let e2 = DVec3::Z.cross(e1);
-    let m = src.magnetisation;
-    let h = multipole::field(
-        q,
-        order,
-        [p.dot(e1), p.dot(e2), p.z],
-        [m.dot(e1), m.dot(e2), m.z],
-    );
-    e1 * h[0] + e2 * h[1] + DVec3::Z * h[2]
-}
-
 /// `magsep chart field --out DIR`: error against distance and against cost.
 ///
 /// # Errors
@@ -208,24 +177,23 @@ pub fn chart_field(out: &Path, quick: bool) -> Result<Vec<Value>, BenchError> {
     };
     let samples = if quick { 50 } else { 400 };
     type Method = Box<dyn Fn(&CylinderSource, DVec3) -> DVec3>;
-    let q: &'static [f64] = Box::leak(multipole::coefficients(RADIUS, 3.0).into_boxed_slice());
     let methods: Vec<(String, Method)> = vec![
-        ("exact closed form".into(), Box::new(closed_only)),
         (
-            "dipole".into(),
-            Box::new(move |s, p| multipole_only(q, s, p, 0)),
+            "exact closed form".into(),
+            Box::new(|s, p| s.field_with(p, None).h),
         ),
+        ("dipole".into(), Box::new(|s, p| s.field_with(p, Some(0)).h)),
         (
             "multipole N=2".into(),
-            Box::new(move |s, p| multipole_only(q, s, p, 2)),
+            Box::new(|s, p| s.field_with(p, Some(2)).h),
         ),
         (
             "multipole N=6".into(),
-            Box::new(move |s, p| multipole_only(q, s, p, 6)),
+            Box::new(|s, p| s.field_with(p, Some(6)).h),
         ),
         (
             "multipole N=16".into(),
-            Box::new(move |s, p| multipole_only(q, s, p, 16)),
+            Box::new(|s, p| s.field_with(p, Some(16)).h),
         ),
         (
             "auto, tolerance 1e-6".into(),

@@ -263,26 +263,7 @@ pub fn attractive_force(scene: &FieldScene, p: DVec3, law: &MomentLaw) -> f64 {
         .iter()
         .min_by(|a, b| a.distance(p).total_cmp(&b.distance(p)));
     match nearest {
-        Some(s) => {
-            // direction to the closest point of the solid cylinder
-            let d = p - s.center;
-            let axis = s.axis();
-            let z = d.dot(axis).clamp(-s.half_length, s.half_length);
-            let radial = d - axis * d.dot(axis);
-            let rl = radial.length();
-            let closest = s.center
-                + axis * z
-                + if rl > s.radius {
-                    radial * (s.radius / rl)
-                } else {
-                    radial
-                };
-            if f.dot(closest - p) > 0.0 {
-                f.length()
-            } else {
-                0.0
-            }
-        }
-        None => f.length(),
+        Some(s) if f.dot(s.closest_point(p) - p) <= 0.0 => 0.0,
+        _ => f.length(),
     }
 }

@@ -95,15 +95,22 @@ impl Simulation {
                 dt: app.world.resource::<StepClock>().dt,
             };
             let mut writer = RecordingWriter::create(path, &meta)?;
-            let (sources, _, _) = scene.field_sources();
+            // the fibres as spawned (stable order by FibreId)
+            let mut fibres: Vec<_> = app
+                .world
+                .query::<(&FibreId, &Fibre)>()
+                .iter(&app.world)
+                .map(|(id, f)| (*id, *f))
+                .collect();
+            fibres.sort_by_key(|(id, _)| *id);
             writer.set_fibres(
-                sources
+                fibres
                     .iter()
-                    .map(|s| FibreShape {
-                        center: s.center,
-                        axis: s.axis(),
-                        radius: s.radius,
-                        half_length: s.half_length,
+                    .map(|(_, f)| FibreShape {
+                        center: f.center,
+                        axis: f.axis,
+                        radius: f.radius,
+                        half_length: f.half_length,
                     })
                     .collect(),
             );

@@ -73,6 +73,34 @@ fn typed<T: DeserializeOwned>(
     }
 }
 
+/// An array of tables (`[[key]]`): each entry typed with its index in the path; entries with
+/// errors are left out (their errors are pushed).
+fn typed_array<T: DeserializeOwned>(
+    value: &toml::Value,
+    key: &str,
+    errors: &mut Vec<SceneError>,
+) -> Vec<(usize, T)> {
+    match value {
+        toml::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .filter_map(|(i, item)| {
+                typed::<T>(item, &format!("{key}[{i}]"), errors).map(|t| (i, t))
+            })
+            .collect(),
+        other => {
+            errors.push(SceneError::new(
+                key,
+                format!(
+                    "must be an array of tables ([[{key}]]), got a {}",
+                    other.type_str()
+                ),
+            ));
+            Vec::new()
+        }
+    }
+}
+
 fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl FnOnce() -> String) {
     if !ok {
         errors.push(SceneError::new(path, message()));
@@ -130,42 +158,10 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             "external_field" => {
                 external_field = typed::<ExternalFieldSection>(value, "external_field", &mut errors)
             }
-            "fibres" => match value {
-                toml::Value::Array(items) => {
-                    for (i, item) in items.iter().enumerate() {
-                        if let Some(f) =
-                            typed::<FibreSpec>(item, &format!("fibres[{i}]"), &mut errors)
-                        {
-                            fibres.push((i, f));
-                        }
-                    }
-                }
-                other => errors.push(SceneError::new(
-                    "fibres",
-                    format!(
-                        "must be an array of tables ([[fibres]]), got a {}",
-                        other.type_str()
-                    ),
-                )),
-            },
-            "particles" => match value {
-                toml::Value::Array(items) => {
-                    for (i, item) in items.iter().enumerate() {
-                        if let Some(g) =
-                            typed::<ParticleGroup>(item, &format!("particles[{i}]"), &mut errors)
-                        {
-                            particles.push((i, g));
-                        }
-                    }
-                }
-                other => errors.push(SceneError::new(
-                    "particles",
-                    format!(
-                        "must be an array of tables ([[particles]]), got a {}",
-                        other.type_str()
-                    ),
-                )),
-            },
+            "fibres" => fibres = typed_array::<FibreSpec>(value, "fibres", &mut errors),
+            "particles" => {
+                particles = typed_array::<ParticleGroup>(value, "particles", &mut errors)
+            }
             other => match registry.get(other) {
                 Some(kind) => {
                     kind.validate(value, other, &mut errors);

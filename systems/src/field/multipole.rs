@@ -75,15 +75,16 @@ pub fn truncation_majorant(order: usize, x: f64) -> f64 {
     6.0 * (m + 1.0) * (m + 2.0) * (m + 3.0) * x.powf(m) / (1.0 - x * x).powi(4)
 }
 
-/// Smallest even order whose [`truncation_majorant`] at `x = a/r` is within `tol`, if any.
-pub fn order_for(x: f64, tol: f64) -> Option<usize> {
+/// Smallest even order up to `max_order` whose [`truncation_majorant`] at `x = a/r` is within
+/// `tol`, if any (an incremental loop: a few flops per order).
+pub fn order_for(x: f64, tol: f64, max_order: usize) -> Option<usize> {
     if x.is_nan() || x >= 1.0 || tol.is_nan() || tol <= 0.0 {
         return None;
     }
     let y = x * x;
     let c = 6.0 / (1.0 - y).powi(4);
     let mut xm = y; // x^m, m = order + 2
-    for order in (0..=MAX_ORDER).step_by(2) {
+    for order in (0..=max_order.min(MAX_ORDER)).step_by(2) {
         let m = (order + 2) as f64;
         if c * (m + 1.0) * (m + 2.0) * (m + 3.0) * xm <= tol {
             return Some(order);
@@ -91,53 +92,6 @@ pub fn order_for(x: f64, tol: f64) -> Option<usize> {
         xm *= y;
     }
     None
-}
-
-/// Largest `x = a/r` at which some order up to [`MAX_ORDER`] meets `tol`, conservatively
-/// (from a table at decades of the tolerance, rounded down to the decade): a cheap test that
-/// rules the expansion out for near points before [`order_for`] is called.
-pub fn x_limit(tol: f64) -> f64 {
-    static TABLE: std::sync::OnceLock<[f64; 16]> = std::sync::OnceLock::new();
-    x_limit_in(&TABLE, MAX_ORDER, tol)
-}
-
-/// [`x_limit`] for expansions up to order `order` only (a table per `order`).
-fn x_limit_in(cell: &std::sync::OnceLock<[f64; 16]>, order: usize, tol: f64) -> f64 {
-    let table = cell.get_or_init(|| {
-        let mut t = [0.0; 16];
-        for (i, v) in t.iter_mut().enumerate() {
-            let tol = 10f64.powi(-15 + i as i32);
-            // bisection on the monotone majorant at the highest order
-            let (mut lo, mut hi) = (0.0, 1.0);
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if truncation_majorant(order, mid) <= tol {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            *v = lo;
-        }
-        t
-    });
-    if tol.is_nan() || tol < 1e-15 {
-        return 0.0;
-    }
-    // index of the largest decade <= tol (no logarithm on the hot path)
-    let mut i = 0;
-    let mut decade = 1e-15;
-    while i < 15 && decade * 10.0 <= tol * (1.0 + 1e-12) {
-        decade *= 10.0;
-        i += 1;
-    }
-    table[i]
-}
-
-/// [`x_limit`] for orders up to [`FAST_ORDER`].
-pub fn x_limit_fast(tol: f64) -> f64 {
-    static TABLE: std::sync::OnceLock<[f64; 16]> = std::sync::OnceLock::new();
-    x_limit_in(&TABLE, FAST_ORDER, tol)
 }
 
 /// Highest order used for speed at a loose tolerance: up to here the expansion is cheaper than
@@ -234,11 +188,11 @@ mod tests {
 
     #[test]
     fn order_selection_is_monotone() {
-        assert_eq!(order_for(1.2, 1e-3), None);
-        assert_eq!(order_for(1e-6, 1e-3), Some(0));
+        assert_eq!(order_for(1.2, 1e-3, MAX_ORDER), None);
+        assert_eq!(order_for(1e-6, 1e-3, MAX_ORDER), Some(0));
         let mut last = 0;
         for x in [0.01, 0.05, 0.1, 0.2] {
-            let n = order_for(x, 1e-12).unwrap_or(MAX_ORDER + 2);
+            let n = order_for(x, 1e-12, MAX_ORDER).unwrap_or(MAX_ORDER + 2);
             assert!(n >= last);
             last = n;
         }
@@ -249,7 +203,7 @@ mod tests {
                 assert!(truncation_majorant(n, x) >= truncation_bound(n, x));
             }
             for tol in [1e-3, 1e-9, 1e-15] {
-                if let Some(n) = order_for(x, tol) {
+                if let Some(n) = order_for(x, tol, MAX_ORDER) {
                     assert!(truncation_majorant(n, x) <= tol, "{x} {tol} {n}");
                     assert!(
                         n == 0 || truncation_majorant(n - 2, x) > tol,

@@ -10,7 +10,7 @@
 
 use glam::{DMat3, DVec3};
 
-use super::cylinder::{AXIS_SWITCH, hess_parts, inside_indicator};
+use super::cylinder::{hess_parts, inside_indicator};
 use super::multipole;
 use super::real::{Dual3, Real};
 
@@ -104,25 +104,23 @@ impl CylinderSource {
         if a2 >= r2 {
             return None;
         }
+        let r = r2.sqrt();
+        let x = self.circumradius / r;
         // a loose tolerance buys speed while the expansion is cheaper than the closed form
-        let xf = multipole::x_limit_fast(tol);
         if tol > EXACT
-            && a2 < xf * xf * r2
-            && let Some(n) = multipole::order_for(self.circumradius / r2.sqrt(), tol)
-            && n <= multipole::FAST_ORDER
+            && let Some(n) = multipole::order_for(x, tol, multipole::FAST_ORDER)
         {
             return Some(n);
         }
         // the closed form's rounding error from its cancelling end terms (conservative):
         // ~1e-16 (r/a)² max(50, r a / R²)
-        let r = r2.sqrt();
         let closed_error =
             1e-16 * (r2 / a2) * (r * self.circumradius / (self.radius * self.radius)).max(50.0);
         if closed_error <= tol.max(1e-13) {
             return None;
         }
-        let x = self.circumradius / r;
-        multipole::order_for(x, tol).or_else(|| multipole::order_for(x, closed_error))
+        multipole::order_for(x, tol, multipole::MAX_ORDER)
+            .or_else(|| multipole::order_for(x, closed_error, multipole::MAX_ORDER))
     }
 
     /// Body-frame `H` (generic: `f64` or [`Dual3`]) and `χ`.
@@ -139,8 +137,14 @@ impl CylinderSource {
     /// `H` [A/m] and `B` [T] at `p` [m] to relative tolerance `tol` ([`EXACT`] for full
     /// precision).
     pub fn field(&self, p: DVec3, tol: f64) -> FieldValue {
+        self.field_with(p, self.multipole_order(p, tol))
+    }
+
+    /// `H` and `B` at `p` by a given method: the multipole expansion through `order`, or with
+    /// `None` the closed form (for comparisons; [`field`](Self::field) chooses by itself).
+    pub fn field_with(&self, p: DVec3, order: Option<usize>) -> FieldValue {
         let d = self.frame.transpose() * (p - self.center);
-        let (h, chi) = self.h_body(d.to_array(), self.multipole_order(p, tol));
+        let (h, chi) = self.h_body(d.to_array(), order);
         let h = self.frame * DVec3::from_array(h);
         FieldValue {
             h,
@@ -187,18 +191,24 @@ impl CylinderSource {
         inside_indicator(rho, d.z, self.radius, self.half_length) > 0.0
     }
 
-    /// Distance [m] from `p` to the solid cylinder (0 inside).
-    pub fn distance(&self, p: DVec3) -> f64 {
-        let d = self.frame.transpose() * (p - self.center);
-        let rho = (d.x * d.x + d.y * d.y).sqrt();
-        let (dr, dz) = (rho - self.radius, d.z.abs() - self.half_length);
-        (dr.max(0.0).powi(2) + dz.max(0.0).powi(2)).sqrt()
+    /// The point of the solid cylinder closest to `p` (`p` itself inside).
+    pub fn closest_point(&self, p: DVec3) -> DVec3 {
+        let d = p - self.center;
+        let axis = self.axis();
+        let z = d.dot(axis);
+        let radial = d - axis * z;
+        let rl = radial.length();
+        let radial = if rl > self.radius {
+            radial * (self.radius / rl)
+        } else {
+            radial
+        };
+        self.center + axis * z.clamp(-self.half_length, self.half_length) + radial
     }
 
-    /// Whether `p` is within the near-axis branch (for diagnostics and tests).
-    pub fn near_axis(&self, p: DVec3) -> bool {
-        let d = self.frame.transpose() * (p - self.center);
-        (d.x * d.x + d.y * d.y).sqrt() < AXIS_SWITCH * self.radius
+    /// Distance [m] from `p` to the solid cylinder (0 inside).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        (p - self.closest_point(p)).length()
     }
 }
 
