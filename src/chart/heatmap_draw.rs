@@ -7,11 +7,9 @@ use crate::chart::data::{Mapper, Rect};
 use crate::chart::svg::{self, DASH, num, text_width};
 use crate::chart::ticks::{self, Axis, Tick, Ticks};
 
-const FS_TITLE: f64 = 14.0;
-const FS_LABEL: f64 = 12.0;
-const FS_TICK: f64 = 11.0;
-const FS_LEGEND: f64 = 11.0;
-const TICK_LEN: f64 = 5.0;
+// the line chart's type sizes and tick length
+use crate::chart::legend::FS_LEGEND;
+use crate::chart::render::{FS_LABEL, FS_TICK, FS_TITLE, TICK_LEN};
 /// Colour bar width and its distance from the plot.
 const BAR_W: f64 = 14.0;
 const BAR_GAP: f64 = 14.0;

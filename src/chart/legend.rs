@@ -7,7 +7,7 @@ use super::data::{Mapper, Rect, Trace};
 use super::svg::{self, DASH, MARKER_R, escape_xml, num, text_width};
 
 /// Legend font size.
-const FS_LEGEND: f64 = 11.0;
+pub(crate) const FS_LEGEND: f64 = 11.0;
 /// Inner padding of the legend box.
 pub(super) const PAD: f64 = 6.0;
 /// Height of one legend row.

@@ -10,10 +10,10 @@ use super::{Chart, LegendPosition};
 
 /// Font size of a figure's overall title.
 pub(crate) const FS_FIGURE_TITLE: f64 = 16.0;
-const FS_TITLE: f64 = 14.0;
-const FS_LABEL: f64 = 12.0;
-const FS_TICK: f64 = 11.0;
-const TICK_LEN: f64 = 5.0;
+pub(crate) const FS_TITLE: f64 = 14.0;
+pub(crate) const FS_LABEL: f64 = 12.0;
+pub(crate) const FS_TICK: f64 = 11.0;
+pub(crate) const TICK_LEN: f64 = 5.0;
 const MINOR_LEN: f64 = 3.0;
 /// Space kept right of the plot frame (for the last x tick label).
 const RIGHT: f64 = 16.0;
