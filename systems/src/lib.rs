@@ -7,6 +7,7 @@
 //! * [`forces`]: fixed-order accumulation of per-contribution force components.
 //! * [`geometry`]: volumes, inertia, segment distances.
 //! * [`field`]: magnetic fields, gradients and forces of magnetised cylinders.
+//! * [`brownian`]: Brownian dynamics of magnetic nanoparticles (thesis 000, ch. 6).
 //! * [`packing`]: the mechanical contraction method.
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
@@ -14,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod brownian;
 pub mod clock;
 pub mod field;
 pub mod forces;

@@ -1,0 +1,1 @@
+//! Hydrodynamic mobilities and Brownian displacements (placeholder; being written).

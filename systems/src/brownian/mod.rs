@@ -1,0 +1,6 @@
+//! Brownian dynamics of magnetic nanoparticles around magnetised fibres (thesis 000, ch. 6).
+//!
+//! * [`hydro`]: mobilities (free draining, Rotne-Prager-Yamakawa) and Brownian displacements
+//!   (dense Cholesky, TEA-HI, Krylov/Lanczos square root).
+
+pub mod hydro;
