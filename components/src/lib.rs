@@ -12,6 +12,7 @@
 
 #![warn(missing_docs)]
 
+pub mod brownian;
 pub mod clock;
 pub mod container;
 pub mod fibre;
@@ -23,6 +24,11 @@ pub mod shape;
 
 /// Everything a user usually needs, in one import.
 pub mod prelude {
+    pub use crate::brownian::{
+        BrownianConfig, BrownianStats, CaptureCurve, CaptureEvent, Captured, ContactForce,
+        ContactModel, DipoleForce, FieldForce, InitialPosition, MagneticMoment, MobilityChoice,
+        MomentModel, StepControl,
+    };
     pub use crate::clock::StepClock;
     pub use crate::container::Container;
     pub use crate::fibre::{ExternalField, Fibre, FibreId};

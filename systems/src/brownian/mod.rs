@@ -4,3 +4,7 @@
 //!   (dense Cholesky, TEA-HI, Krylov/Lanczos square root).
 
 pub mod hydro;
+pub mod cells;
+pub mod model;
+pub mod pair;
+pub mod stepper;

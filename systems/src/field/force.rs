@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::source::FieldGradient;
 
 /// Boltzmann constant [J/K].
-pub const K_B: f64 = 1.380_649e-23;
+pub const K_B: f64 = magsep_components::brownian::BOLTZMANN;
 
 /// How a particle's moment magnitude depends on the field.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -44,16 +44,7 @@ impl MomentLaw {
     }
 }
 
-/// Langevin function `coth x - 1/x` (series below |x| = 1e-3, where the difference cancels).
-pub fn langevin(x: f64) -> f64 {
-    if x.abs() < 1e-3 {
-        x / 3.0 - x * x * x / 45.0
-    } else if x.abs() > 40.0 {
-        x.signum() - 1.0 / x
-    } else {
-        1.0 / x.tanh() - 1.0 / x
-    }
-}
+pub use magsep_components::brownian::langevin;
 
 /// Force [N] on a dipole with moment law `law` in a field with gradient `g`.
 ///
@@ -69,18 +60,26 @@ pub fn langevin(x: f64) -> f64 {
 /// assert!((f.x - 2e-15).abs() < 1e-30);
 /// ```
 pub fn dipole_force(g: &FieldGradient, law: &MomentLaw) -> DVec3 {
+    grad_abs_b(g)
+        .map(|(bm, grad)| grad * law.magnitude(bm))
+        .unwrap_or(DVec3::ZERO)
+}
+
+/// `(|B|, ∇|B|)` with `∂|B|/∂x_j = B̂ · ∂B/∂x_j`; `None` where B vanishes or is not finite.
+pub fn grad_abs_b(g: &FieldGradient) -> Option<(f64, DVec3)> {
     let bmag = g.b.length();
     if bmag == 0.0 || !bmag.is_finite() {
-        return DVec3::ZERO;
+        return None;
     }
     let bhat = g.b / bmag;
-    // ∂|B|/∂x_j = B̂ · ∂B/∂x_j
-    let grad = DVec3::new(
-        bhat.dot(g.grad_b.x_axis),
-        bhat.dot(g.grad_b.y_axis),
-        bhat.dot(g.grad_b.z_axis),
-    );
-    grad * law.magnitude(bmag)
+    Some((
+        bmag,
+        DVec3::new(
+            bhat.dot(g.grad_b.x_axis),
+            bhat.dot(g.grad_b.y_axis),
+            bhat.dot(g.grad_b.z_axis),
+        ),
+    ))
 }
 
 #[cfg(test)]

@@ -1,0 +1,264 @@
+//! Brownian dynamics data: moments, force contributions, capture flags and the pipeline's
+//! configuration (thesis 000, ch. 6). SI units throughout.
+
+use bevy_ecs::prelude::*;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::forces::ForceContribution;
+
+/// Boltzmann constant k_B [J/K].
+pub const BOLTZMANN: f64 = 1.380_649e-23;
+
+/// How a particle's magnetic moment follows the local flux density B. The moment is always
+/// parallel to B (superparamagnetic particles, thesis L1673).
+///
+/// ```
+/// use magsep_components::brownian::MomentModel;
+/// let m = MomentModel::Langevin { moment: 1e-16, domain_moment: 2.3e-19 };
+/// let kt = 1.380649e-23 * 298.0;
+/// // x = 2.3e-19 * 1 T / kT = 55.9: L(x) = coth x - 1/x = 0.982
+/// assert!((m.magnitude(1.0, kt) / 1e-16 - 0.98211).abs() < 1e-4);
+/// ```
+#[derive(Component, Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MomentModel {
+    /// Non-magnetic.
+    #[default]
+    None,
+    /// Saturated: `|m| = moment` [A m²] (the thesis's table 6.1 moments at ~1 T).
+    Saturated {
+        /// Moment μ_s [A m²]. Range: > 0.
+        moment: f64,
+    },
+    /// Langevin (thesis eq. 6.22): `|m| = moment · L(x)`, `x = domain_moment |B| / (k_B T)`,
+    /// `L(x) = coth x − 1/x`.
+    Langevin {
+        /// Saturation moment of the particle μ_s [A m²]. Range: > 0.
+        moment: f64,
+        /// Moment of one single-domain core μ_d [A m²] (2.3e-19 for a 10 nm magnetite core).
+        /// Range: > 0.
+        domain_moment: f64,
+    },
+}
+
+impl MomentModel {
+    /// `|m|` [A m²] at flux density magnitude `b` [T] and thermal energy `kt` [J].
+    pub fn magnitude(&self, b: f64, kt: f64) -> f64 {
+        match *self {
+            Self::None => 0.0,
+            Self::Saturated { moment } => moment,
+            Self::Langevin {
+                moment,
+                domain_moment,
+            } => moment * langevin(domain_moment * b / kt),
+        }
+    }
+
+    /// Whether the particle carries a moment.
+    pub fn is_magnetic(&self) -> bool {
+        !matches!(self, Self::None)
+    }
+}
+
+/// Langevin function `coth x − 1/x` (series where the difference cancels).
+pub fn langevin(x: f64) -> f64 {
+    if x.abs() < 1e-3 {
+        x / 3.0 - x * x * x / 45.0
+    } else if x.abs() > 40.0 {
+        x.signum() - 1.0 / x
+    } else {
+        1.0 / x.tanh() - 1.0 / x
+    }
+}
+
+macro_rules! contribution {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+        pub struct $name(pub DVec3);
+
+        impl ForceContribution for $name {
+            fn force(&self) -> DVec3 {
+                self.0
+            }
+            fn clear(&mut self) {
+                self.0 = DVec3::ZERO;
+            }
+        }
+    };
+}
+
+contribution!(
+    /// Force of the applied field and the fibres on the particle's moment, `|m| ∇|B|` [N].
+    FieldForce
+);
+contribution!(
+    /// Sum of dipole-dipole forces from the other particles within the cut-off [N].
+    DipoleForce
+);
+contribution!(
+    /// Soft-core (Mie) contact force from the other particles [N].
+    ContactForce
+);
+
+/// The particle's current magnetic moment m [A m²] (parallel to the local B).
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MagneticMoment(pub DVec3);
+
+/// Where the particle started [m] (for the mean square displacement and the Brownian criterion).
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct InitialPosition(pub DVec3);
+
+/// Capture on a fibre: once set the particle is fixed for the rest of the run.
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Captured(pub Option<CaptureEvent>);
+
+/// When and where a particle was captured.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CaptureEvent {
+    /// Step at whose end the particle touched the fibre.
+    pub step: u64,
+    /// Fibre index (`FibreId`).
+    pub fibre: u64,
+}
+
+/// Mobility choice of the scene (`mobility = "auto"`, ...).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MobilityChoice {
+    /// Pick by particle count and concentration (the summary says what was picked).
+    #[default]
+    Auto,
+    /// No hydrodynamic interactions: `D_ii = k_B T / (6 π η a_i)`.
+    FreeDraining,
+    /// Rotne-Prager-Yamakawa with dense Cholesky displacements (exact, O(N³)).
+    Cholesky,
+    /// Rotne-Prager-Yamakawa with the TEA-HI displacements of Geyer and Winter (O(N²)).
+    Tea,
+    /// Rotne-Prager-Yamakawa with Krylov (Lanczos) square-root displacements.
+    Krylov,
+}
+
+/// Time stepping of the Ermak-McCammon update.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum StepControl {
+    /// One explicit Euler step of `dt` per step (the thesis's scheme).
+    Fixed,
+    /// Step doubling on a Brownian tree: each `dt` is bisected until the one-step and
+    /// two-half-step results agree within `tolerance` and no particle moves more than
+    /// `max_displacement` (both in units of its radius).
+    Adaptive {
+        /// Local error tolerance in units of the particle radius. Default 1e-3. Range (0, 1].
+        tolerance: f64,
+        /// Largest move of one accepted sub-step in units of the radius. Default 0.2.
+        /// Range (0, 10].
+        max_displacement: f64,
+        /// Deepest bisection (sub-steps of dt / 2^depth). Default 24. Range 1..=40.
+        max_depth: u32,
+    },
+}
+
+impl Default for StepControl {
+    fn default() -> Self {
+        Self::Adaptive {
+            tolerance: 1e-3,
+            max_displacement: 0.2,
+            max_depth: 24,
+        }
+    }
+}
+
+/// Particle-particle excluded volume.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContactModel {
+    /// None (ideal particles).
+    None,
+    /// Pseudo-hard spheres: Mie(n, m) shifted and truncated at its minimum (thesis eq. 6.19).
+    Mie {
+        /// Well depth ε in units of k_B T. Default 100. Range (0, 1e6].
+        epsilon_kt: f64,
+        /// Repulsive exponent n. Default 30.
+        n: f64,
+        /// Attractive exponent m < n. Default 15.
+        m: f64,
+    },
+    /// Hard spheres: after every (sub-)step overlapping pairs are pushed apart to contact.
+    HardCore,
+}
+
+impl Default for ContactModel {
+    fn default() -> Self {
+        Self::Mie {
+            epsilon_kt: 100.0,
+            n: 30.0,
+            m: 15.0,
+        }
+    }
+}
+
+/// Configuration of the `brownian` pipeline (a resource).
+#[derive(Resource, Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BrownianConfig {
+    /// Temperature T [K]. Default 298.
+    pub temperature: f64,
+    /// Fluid viscosity η [Pa s]. Default 1e-3.
+    pub viscosity: f64,
+    /// Number of steps of `dt` to run (duration / dt, rounded).
+    pub steps: u64,
+    /// Mobility.
+    pub mobility: MobilityChoice,
+    /// Relative tolerance of the Krylov square root. Default 1e-6.
+    pub krylov_tolerance: f64,
+    /// Time stepping.
+    pub step_control: StepControl,
+    /// Excluded volume.
+    pub contact: ContactModel,
+    /// Dipole-dipole cut-off in units of the mean radius of a pair; `None`: no dipole forces.
+    /// Default 30.
+    pub dipole_cutoff: Option<f64>,
+    /// Whether captured particles keep exerting dipole and contact forces on free ones.
+    /// Default true.
+    pub captured_interact: bool,
+    /// Sample the capture curve every this many steps. Default: steps / 200.
+    pub observe_every: u64,
+}
+
+impl BrownianConfig {
+    /// Thermal energy k_B T [J].
+    pub fn kt(&self) -> f64 {
+        BOLTZMANN * self.temperature
+    }
+}
+
+/// Counters of the time stepper and the interactions (a resource).
+#[derive(Resource, Debug, Default, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BrownianStats {
+    /// Accepted sub-steps in all.
+    pub substeps: u64,
+    /// Rejected trial sub-steps (bisected).
+    pub rejections: u64,
+    /// Deepest bisection reached.
+    pub max_depth_reached: u32,
+    /// Sub-steps accepted at the depth limit without meeting the tolerance.
+    pub depth_limit_hits: u64,
+    /// Force evaluations.
+    pub force_evaluations: u64,
+    /// Hard-core overlap-removal sweeps.
+    pub hard_core_sweeps: u64,
+    /// Mobility method actually used (resolved from `auto`).
+    pub mobility: String,
+    /// Why that mobility was chosen.
+    pub mobility_reason: String,
+    /// Krylov iterations in all.
+    pub krylov_iterations: u64,
+}
+
+/// Capture curve of one run: `(step, captured count)` samples (a resource).
+#[derive(Resource, Debug, Default, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaptureCurve {
+    /// Samples `(step, captured particles)`, in step order.
+    pub samples: Vec<(u64, u64)>,
+}

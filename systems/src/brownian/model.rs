@@ -1,0 +1,268 @@
+//! The force model of the Brownian pipeline: field force on superparamagnetic moments,
+//! dipole-dipole forces within a cut-off, and Mie(30, 15) pseudo-hard-sphere contacts
+//! (thesis 000, eqs. 6.12, 6.19-6.23).
+//!
+//! * Moments are parallel to the local flux density B = B_ext + Σ fibres (ch. 5 fields), with
+//!   magnitude from [`MomentModel`] (saturated, or Langevin eq. 6.22). Mutual induction
+//!   between particles is neglected, as in the thesis (L1677: it matters only at ~mT fields).
+//! * Field force `F = |m| ∇|B|` ([`crate::field::dipole_force`]); with no fibres the applied
+//!   field is uniform and exerts no force.
+//! * Pair forces are summed per particle over a [`CellList`] in a fixed order, in parallel over
+//!   particles: bitwise identical for any thread count.
+//!
+//! Which particles feel forces (`mobile`) and which exert pair forces (`exerts`) are separate
+//! masks, so captured particles can keep or stop interacting (a scene option).
+
+use glam::DVec3;
+use magsep_components::brownian::MomentModel;
+use rayon::prelude::*;
+
+use super::cells::CellList;
+use super::pair::{Mie, dipole_force};
+use crate::field::force::grad_abs_b;
+use crate::field::{CylinderSource, FieldGradient, total_field, total_field_gradient};
+
+/// Per-particle data the force model reads (all slices of length N, in `ParticleId` order).
+#[derive(Debug, Clone, Copy)]
+pub struct ParticleView<'a> {
+    /// Radii a_i [m].
+    pub radii: &'a [f64],
+    /// Moment laws.
+    pub moments: &'a [MomentModel],
+    /// Particles that move and feel forces (not captured).
+    pub mobile: &'a [bool],
+    /// Particles that exert pair forces on others.
+    pub exerts: &'a [bool],
+}
+
+/// The three force contributions and the moments at one configuration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ForceParts {
+    /// Field force [N].
+    pub field: Vec<DVec3>,
+    /// Dipole-dipole force [N].
+    pub dipole: Vec<DVec3>,
+    /// Contact force [N].
+    pub contact: Vec<DVec3>,
+    /// Moments [A m²].
+    pub moments: Vec<DVec3>,
+}
+
+impl ForceParts {
+    /// Zeroed parts for `n` particles.
+    pub fn zeros(n: usize) -> Self {
+        Self {
+            field: vec![DVec3::ZERO; n],
+            dipole: vec![DVec3::ZERO; n],
+            contact: vec![DVec3::ZERO; n],
+            moments: vec![DVec3::ZERO; n],
+        }
+    }
+
+    /// Sum of the three forces on particle `i` [N].
+    #[inline]
+    pub fn total(&self, i: usize) -> DVec3 {
+        self.field[i] + self.dipole[i] + self.contact[i]
+    }
+}
+
+/// Fibres, applied field and interaction parameters.
+#[derive(Debug, Clone)]
+pub struct ForceModel {
+    /// Magnetised fibres.
+    pub sources: Vec<CylinderSource>,
+    /// Applied flux density [T].
+    pub b_ext: glam::DVec3,
+    /// Field tolerance (relative).
+    pub tolerance: f64,
+    /// Thermal energy k_B T [J].
+    pub kt: f64,
+    /// Mie contact (None: no soft core).
+    pub mie: Option<Mie>,
+    /// Dipole cut-off in units of the pair's mean radius (None: no dipole forces).
+    pub dipole_cutoff: Option<f64>,
+}
+
+/// Parallel map over particles in chunks (sequential below 512 particles).
+fn par_fill<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
+    if out.len() < 512 {
+        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
+    } else {
+        out.par_iter_mut()
+            .with_min_len(128)
+            .enumerate()
+            .for_each(|(i, o)| f(i, o));
+    }
+}
+
+impl ForceModel {
+    /// The moment of a particle with law `law` in flux density `b` [A m²].
+    #[inline]
+    pub fn moment(&self, law: &MomentModel, b: DVec3) -> DVec3 {
+        let bm = b.length();
+        if bm == 0.0 || !law.is_magnetic() {
+            return DVec3::ZERO;
+        }
+        b * (law.magnitude(bm, self.kt) / bm)
+    }
+
+    /// The field and its gradient at `p` (uniform applied field when there are no fibres).
+    pub fn field_gradient(&self, p: DVec3) -> FieldGradient {
+        if self.sources.is_empty() {
+            return FieldGradient {
+                b: self.b_ext,
+                grad_b: glam::DMat3::ZERO,
+            };
+        }
+        total_field_gradient(&self.sources, self.b_ext, p, self.tolerance)
+    }
+
+    /// Moments of every particle (B only, no gradient).
+    pub fn moments(&self, x: &[DVec3], view: &ParticleView, out: &mut [DVec3]) {
+        par_fill(out, |i, m| {
+            let law = &view.moments[i];
+            *m = if law.is_magnetic() {
+                let b = if self.sources.is_empty() {
+                    self.b_ext
+                } else {
+                    total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
+                };
+                self.moment(law, b)
+            } else {
+                DVec3::ZERO
+            }
+        });
+    }
+
+    /// Field forces on the mobile particles [N].
+    pub fn field_forces(&self, x: &[DVec3], view: &ParticleView, out: &mut [DVec3]) {
+        if self.sources.is_empty() {
+            out.fill(DVec3::ZERO);
+            return;
+        }
+        par_fill(out, |i, f| {
+            let law = &view.moments[i];
+            *f = if view.mobile[i] && law.is_magnetic() {
+                let g = self.field_gradient(x[i]);
+                magnetic_force(&g, law, self.kt)
+            } else {
+                DVec3::ZERO
+            }
+        });
+    }
+
+    /// Largest pair interaction range [m] for the cell list (0: no pair forces).
+    pub fn pair_range(&self, view: &ParticleView) -> f64 {
+        let amax = view.radii.iter().copied().fold(0.0, f64::max);
+        let dip = self.dipole_cutoff.map(|c| c * amax).unwrap_or(0.0);
+        let mie = self.mie.map(|m| 2.0 * amax * m.min_ratio).unwrap_or(0.0);
+        dip.max(mie)
+    }
+
+    /// Cell list of the particles that exert pair forces.
+    pub fn cells(&self, x: &[DVec3], view: &ParticleView) -> Option<CellList> {
+        let range = self.pair_range(view);
+        (range > 0.0).then(|| CellList::build(x, range, |j| view.exerts[j]))
+    }
+
+    /// Dipole-dipole forces on the mobile particles from the exerting ones [N].
+    pub fn dipole_forces(
+        &self,
+        x: &[DVec3],
+        moments: &[DVec3],
+        view: &ParticleView,
+        cells: Option<&CellList>,
+        out: &mut [DVec3],
+    ) {
+        let (Some(cut), Some(cells)) = (self.dipole_cutoff, cells) else {
+            out.fill(DVec3::ZERO);
+            return;
+        };
+        par_fill(out, |i, f| {
+            *f = DVec3::ZERO;
+            if !view.mobile[i] || moments[i] == DVec3::ZERO {
+                return;
+            }
+            let (ai, mi) = (view.radii[i], moments[i]);
+            let mut sum = DVec3::ZERO;
+            cells.for_each_neighbour(x, i, cells.edge(), |j, d| {
+                let rc = cut * 0.5 * (ai + view.radii[j]);
+                if d.length_squared() < rc * rc {
+                    sum += dipole_force(d, mi, moments[j]);
+                }
+            });
+            *f = sum;
+        });
+    }
+
+    /// Mie contact forces on the mobile particles from the exerting ones [N].
+    pub fn contact_forces(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        cells: Option<&CellList>,
+        out: &mut [DVec3],
+    ) {
+        let (Some(mie), Some(cells)) = (self.mie, cells) else {
+            out.fill(DVec3::ZERO);
+            return;
+        };
+        par_fill(out, |i, f| {
+            *f = DVec3::ZERO;
+            if !view.mobile[i] {
+                return;
+            }
+            let ai = view.radii[i];
+            let mut sum = DVec3::ZERO;
+            cells.for_each_neighbour(x, i, cells.edge(), |j, d| {
+                sum += mie.force(d, ai + view.radii[j]);
+            });
+            *f = sum;
+        });
+    }
+
+    /// All parts at configuration `x` (the sub-step evaluation of the integrator).
+    pub fn evaluate(&self, x: &[DVec3], view: &ParticleView, parts: &mut ForceParts) {
+        let n = x.len();
+        if parts.field.len() != n {
+            *parts = ForceParts::zeros(n);
+        }
+        // moments and field forces from one field evaluation per particle
+        let pairs: Vec<(DVec3, DVec3)> = {
+            let mut v = vec![(DVec3::ZERO, DVec3::ZERO); n];
+            par_fill(&mut v, |i, o| {
+                let law = &view.moments[i];
+                if !law.is_magnetic() {
+                    *o = (DVec3::ZERO, DVec3::ZERO);
+                } else if view.mobile[i] && !self.sources.is_empty() {
+                    let g = self.field_gradient(x[i]);
+                    *o = (self.moment(law, g.b), magnetic_force(&g, law, self.kt));
+                } else if view.exerts[i] || view.mobile[i] {
+                    let b = if self.sources.is_empty() {
+                        self.b_ext
+                    } else {
+                        total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
+                    };
+                    *o = (self.moment(law, b), DVec3::ZERO);
+                }
+            });
+            v
+        };
+        for (i, (m, f)) in pairs.into_iter().enumerate() {
+            parts.moments[i] = m;
+            parts.field[i] = f;
+        }
+        let cells = self.cells(x, view);
+        let moments = std::mem::take(&mut parts.moments);
+        self.dipole_forces(x, &moments, view, cells.as_ref(), &mut parts.dipole);
+        parts.moments = moments;
+        self.contact_forces(x, view, cells.as_ref(), &mut parts.contact);
+    }
+}
+
+/// `|m|(|B|) ∇|B|` for a moment law (the force on an induced moment parallel to B).
+pub fn magnetic_force(g: &FieldGradient, law: &MomentModel, kt: f64) -> DVec3 {
+    grad_abs_b(g)
+        .map(|(bm, grad)| grad * law.magnitude(bm, kt))
+        .unwrap_or(DVec3::ZERO)
+}
