@@ -8,3 +8,6 @@ pub mod cells;
 pub mod model;
 pub mod pair;
 pub mod stepper;
+pub mod contact;
+pub mod dynamics;
+pub mod systems;

@@ -111,7 +111,10 @@ fn stiff_trap_fixed_step_diverges_adaptive_is_stable_with_boltzmann_variance() {
         (var, stats)
     };
     let (var_fixed, _) = run(StepControl::Fixed);
-    assert!(!(var_fixed < 1e6), "fixed step should blow up, variance {var_fixed}");
+    assert!(
+        var_fixed.is_nan() || var_fixed >= 1e6,
+        "fixed step should blow up, variance {var_fixed}"
+    );
     let (var, stats) = run(adaptive(1e-3, 0.5));
     // Boltzmann: <x²> = kT / k = 0.2 per component (Euler's own bias ~ mu k h / 2 is small at
     // the accepted sub-steps); standard error sqrt(2/12000) = 1.3 %

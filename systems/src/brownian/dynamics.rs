@@ -1,0 +1,175 @@
+//! The physics behind the stepper: forces from the [`ForceModel`], mobility (free draining or
+//! a prepared RPY [`Mobility`] over the free particles), hard cores and capture.
+
+use glam::DVec3;
+use magsep_components::brownian::{CaptureEvent, MomentModel};
+
+use super::contact::{remove_overlaps, swept_capture};
+use super::hydro::Mobility;
+use super::model::{ForceModel, ForceParts, ParticleView};
+use super::stepper::Dynamics;
+
+/// Hydrodynamic interactions among the free particles: the prepared mobility and the particle
+/// index of each of its rows.
+pub struct HydroState {
+    /// Mobility of the free particles at the start of the step.
+    pub mobility: Mobility,
+    /// Particle index of each mobility row.
+    pub rows: Vec<usize>,
+}
+
+/// One step's view of the pipeline state as [`Dynamics`].
+pub struct PipelineDynamics<'a> {
+    /// Force model.
+    pub model: &'a ForceModel,
+    /// Radii [m].
+    pub radii: &'a [f64],
+    /// Moment laws.
+    pub laws: &'a [MomentModel],
+    /// Free particles (cleared on capture).
+    pub mobile: Vec<bool>,
+    /// Whether captured particles keep exerting pair forces.
+    pub captured_interact: bool,
+    /// Forces from contributions outside the model (user plugins), held over the step [N].
+    pub extra: &'a [DVec3],
+    /// Viscosity [Pa s].
+    pub viscosity: f64,
+    /// Thermal energy [J].
+    pub kt: f64,
+    /// Hydrodynamic interactions (None: free draining).
+    pub hydro: Option<&'a HydroState>,
+    /// Hard cores.
+    pub hard_core: bool,
+    /// Step being taken (for capture events).
+    pub step: u64,
+    /// Capture events of this step.
+    pub captures: Vec<(usize, CaptureEvent)>,
+    /// Force evaluation scratch.
+    pub parts: ForceParts,
+    /// Hard-core sweeps used.
+    pub sweeps: u64,
+    /// First Krylov/TEA failure met.
+    pub failure: Option<String>,
+}
+
+impl PipelineDynamics<'_> {
+    fn exerts(&self) -> Vec<bool> {
+        self.mobile
+            .iter()
+            .map(|&m| m || self.captured_interact)
+            .collect()
+    }
+
+    /// Velocities from forces `f` (masked to the free particles).
+    pub fn velocities(&self, f: &[DVec3], v: &mut [DVec3]) {
+        match self.hydro {
+            None => {
+                for i in 0..f.len() {
+                    v[i] = if self.mobile[i] {
+                        f[i] / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
+                    } else {
+                        DVec3::ZERO
+                    };
+                }
+            }
+            Some(h) => {
+                let fs: Vec<DVec3> = h.rows.iter().map(|&i| f[i]).collect();
+                let mut vs = vec![DVec3::ZERO; fs.len()];
+                h.mobility.apply(&fs, &mut vs);
+                v.fill(DVec3::ZERO);
+                for (k, &i) in h.rows.iter().enumerate() {
+                    if self.mobile[i] {
+                        v[i] = vs[k];
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl Dynamics for PipelineDynamics<'_> {
+    fn radii(&self) -> &[f64] {
+        self.radii
+    }
+
+    fn mobile(&self) -> &[bool] {
+        &self.mobile
+    }
+
+    fn drift(&mut self, x: &[DVec3], v: &mut [DVec3]) {
+        let exerts = self.exerts();
+        let view = ParticleView {
+            radii: self.radii,
+            moments: self.laws,
+            mobile: &self.mobile,
+            exerts: &exerts,
+        };
+        let mut parts = std::mem::take(&mut self.parts);
+        self.model.evaluate(x, &view, &mut parts);
+        let f: Vec<DVec3> = (0..x.len())
+            .map(|i| parts.total(i) + self.extra[i])
+            .collect();
+        self.parts = parts;
+        self.velocities(&f, v);
+    }
+
+    fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]) {
+        match self.hydro {
+            None => {
+                for i in 0..w.len() {
+                    out[i] = if self.mobile[i] {
+                        let mu = 1.0 / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]);
+                        w[i] * (2.0 * self.kt * mu).sqrt()
+                    } else {
+                        DVec3::ZERO
+                    };
+                }
+            }
+            Some(h) => {
+                let ws: Vec<DVec3> = h.rows.iter().map(|&i| w[i]).collect();
+                let mut ys = vec![DVec3::ZERO; ws.len()];
+                if let Err(e) = h.mobility.noise(&ws, &mut ys)
+                    && self.failure.is_none()
+                {
+                    self.failure = Some(e.to_string());
+                }
+                let s = (2.0 * self.kt).sqrt();
+                out.fill(DVec3::ZERO);
+                for (k, &i) in h.rows.iter().enumerate() {
+                    if self.mobile[i] {
+                        out[i] = ys[k] * s;
+                    }
+                }
+            }
+        }
+    }
+
+    fn constrain(&mut self, _from: &[DVec3], x: &mut [DVec3]) {
+        if self.hard_core {
+            let mobile = self.mobile.clone();
+            self.sweeps += remove_overlaps(x, self.radii, &mobile, 1000) as u64;
+        }
+    }
+
+    fn accept(&mut self, from: &[DVec3], x: &mut [DVec3], _t: f64) {
+        if self.model.sources.is_empty() {
+            return;
+        }
+        for i in 0..x.len() {
+            if !self.mobile[i] {
+                continue;
+            }
+            if let Some((k, p)) = swept_capture(&self.model.sources, from[i], x[i], self.radii[i]) {
+                x[i] = p;
+                self.mobile[i] = false;
+                self.captures.push((
+                    i,
+                    CaptureEvent {
+                        step: self.step,
+                        fibre: k as u64,
+                    },
+                ));
+            }
+        }
+    }
+}

@@ -1,0 +1,404 @@
+//! Thin ECS glue of the `brownian` pipeline: gather particles into the dense
+//! [`BrownianWorkspace`], write the three force contributions, prepare the mobility, run the
+//! stepper, write back, sample the capture curve.
+//!
+//! | set | system | reads | writes |
+//! |---|---|---|---|
+//! | `Prepare` | [`prepare_brownian_step`] | | `BrownianWorkspace` (moments, cells) |
+//! | `Forces::Field` | [`compute_field_forces`] | `BrownianWorkspace` | `FieldForce`, `MagneticMoment` |
+//! | `Forces::Dipole` | [`compute_dipole_forces`] | `BrownianWorkspace` | `DipoleForce` |
+//! | `Forces::Contact` | [`compute_contact_forces`] | `BrownianWorkspace` | `ContactForce` |
+//! | `Mobility` | [`prepare_mobility`] | `BrownianConfig` | `BrownianWorkspace`, `BrownianStats` |
+//! | `Integrate` | [`integrate_brownian`] | forces, `StepClock` | `BrownianWorkspace`, `BrownianStats`, `Health` |
+//! | `Finalize::WriteBack` | [`write_back_brownian`] | `BrownianWorkspace` | `Position`, `Captured`, `ParticleRng` |
+//! | `Observe` | [`observe_capture`] | `BrownianWorkspace` | `CaptureCurve` |
+
+use bevy_ecs::prelude::*;
+use glam::DVec3;
+use magsep_components::prelude::*;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::cells::CellList;
+use super::dynamics::{HydroState, PipelineDynamics};
+use super::hydro::{Mobility, MobilityMethod, auto_method};
+use super::model::{ForceModel, ParticleView};
+use super::pair::Mie;
+use super::stepper::advance;
+use crate::field::CylinderSource;
+
+/// Dense state of the run in `ParticleId` order (a resource; authoritative during a run, copied
+/// to the components every step).
+#[derive(Resource)]
+pub struct BrownianWorkspace {
+    /// Entities in `ParticleId` order.
+    pub entities: Vec<Entity>,
+    /// Centres [m].
+    pub positions: Vec<DVec3>,
+    /// Radii [m].
+    pub radii: Vec<f64>,
+    /// Moment laws.
+    pub laws: Vec<MomentModel>,
+    /// Capture state.
+    pub captured: Vec<Option<CaptureEvent>>,
+    /// Random streams.
+    pub rngs: Vec<Xoshiro256PlusPlus>,
+    /// Fibres, field and interactions.
+    pub model: ForceModel,
+    /// Moments at the step start [A m²].
+    pub moments: Vec<DVec3>,
+    /// Cell list at the step start.
+    pub cells: Option<CellList>,
+    /// Mobility of this step (None: free draining).
+    pub hydro: Option<HydroState>,
+    /// Resolved mobility method.
+    pub method: MobilityMethod,
+}
+
+impl BrownianWorkspace {
+    /// Free particles.
+    pub fn mobile(&self) -> Vec<bool> {
+        self.captured.iter().map(Option::is_none).collect()
+    }
+
+    /// Particles exerting pair forces.
+    pub fn exerts(&self, config: &BrownianConfig) -> Vec<bool> {
+        self.captured
+            .iter()
+            .map(|c| c.is_none() || config.captured_interact)
+            .collect()
+    }
+
+    /// Number of captured particles.
+    pub fn captured_count(&self) -> u64 {
+        self.captured.iter().filter(|c| c.is_some()).count() as u64
+    }
+}
+
+/// The force model of a configuration and fibre list.
+pub fn force_model(config: &BrownianConfig, fibres: &[Fibre], field: &ExternalField) -> ForceModel {
+    let kt = config.kt();
+    ForceModel {
+        sources: fibres
+            .iter()
+            .map(|f| {
+                CylinderSource::new(f.center, f.axis, f.radius, f.half_length, f.magnetisation)
+            })
+            .collect(),
+        b_ext: field.flux_density,
+        tolerance: field.tolerance,
+        kt,
+        mie: match config.contact {
+            ContactModel::Mie { epsilon_kt, n, m } => Some(Mie::new(epsilon_kt * kt, n, m)),
+            _ => None,
+        },
+        dipole_cutoff: config.dipole_cutoff,
+    }
+}
+
+/// Volume fraction of the particles in their bounding box (for the `auto` mobility rule).
+fn bounding_volume_fraction(x: &[DVec3], radii: &[f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for (p, a) in x.iter().zip(radii) {
+        lo = lo.min(*p - DVec3::splat(*a));
+        hi = hi.max(*p + DVec3::splat(*a));
+    }
+    let v: f64 = radii.iter().map(|a| 4.0 / 3.0 * std::f64::consts::PI * a.powi(3)).sum();
+    (v / (hi - lo).element_product()).min(1.0)
+}
+
+/// Gather the spawned particles into a [`BrownianWorkspace`] (plugin `finish` hook).
+/// Requires `BrownianConfig` and `ExternalField`.
+pub fn init_brownian_workspace(world: &mut World) {
+    let config = world.resource::<BrownianConfig>().clone();
+    let field = *world.resource::<ExternalField>();
+    let mut fibres: Vec<(FibreId, Fibre)> = world
+        .query::<(&FibreId, &Fibre)>()
+        .iter(world)
+        .map(|(i, f)| (*i, *f))
+        .collect();
+    fibres.sort_by_key(|f| f.0);
+    let fibres: Vec<Fibre> = fibres.into_iter().map(|f| f.1).collect();
+    type Row<'a> = (
+        Entity,
+        &'a ParticleId,
+        &'a Position,
+        &'a Shape,
+        Option<&'a MomentModel>,
+        Option<&'a Captured>,
+        &'a ParticleRng,
+    );
+    let mut rows: Vec<_> = world
+        .query::<Row>()
+        .iter(world)
+        .map(|(e, id, p, s, m, c, r)| {
+            (*id, e, p.0, s.radius(), m.copied().unwrap_or_default(), c.and_then(|c| c.0), r.0.clone())
+        })
+        .collect();
+    rows.sort_by_key(|r| r.0);
+    let positions: Vec<DVec3> = rows.iter().map(|r| r.2).collect();
+    let radii: Vec<f64> = rows.iter().map(|r| r.3).collect();
+    let n_free = rows.iter().filter(|r| r.5.is_none()).count();
+    let (method, reason) = match config.mobility {
+        MobilityChoice::Auto => auto_method(n_free, bounding_volume_fraction(&positions, &radii)),
+        MobilityChoice::FreeDraining => (MobilityMethod::FreeDraining, "chosen in the scene"),
+        MobilityChoice::Cholesky => (MobilityMethod::Cholesky, "chosen in the scene"),
+        MobilityChoice::Tea => (MobilityMethod::Tea, "chosen in the scene"),
+        MobilityChoice::Krylov => (MobilityMethod::Krylov, "chosen in the scene"),
+    };
+    let mut stats = world.get_resource::<BrownianStats>().cloned().unwrap_or_default();
+    stats.mobility = serde_json::to_value(method)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    stats.mobility_reason = reason.to_string();
+    world.insert_resource(stats);
+    world.insert_resource(BrownianWorkspace {
+        entities: rows.iter().map(|r| r.1).collect(),
+        moments: vec![DVec3::ZERO; rows.len()],
+        laws: rows.iter().map(|r| r.4).collect(),
+        captured: rows.iter().map(|r| r.5).collect(),
+        rngs: rows.iter().map(|r| r.6.clone()).collect(),
+        positions,
+        radii,
+        model: force_model(&config, &fibres, &field),
+        cells: None,
+        hydro: None,
+        method,
+    });
+    let step = world.get_resource::<StepClock>().map(|c| c.step).unwrap_or(0);
+    let captured = world.resource::<BrownianWorkspace>().captured_count();
+    let mut curve = world.get_resource_or_init::<CaptureCurve>();
+    if curve.samples.is_empty() {
+        curve.samples.push((step, captured));
+    }
+}
+
+/// Moments and the cell list at the step start.
+pub fn prepare_brownian_step(mut ws: ResMut<BrownianWorkspace>, config: Res<BrownianConfig>) {
+    let ws = &mut *ws;
+    let mobile = ws.mobile();
+    let exerts = ws.exerts(&config);
+    let view = ParticleView {
+        radii: &ws.radii,
+        moments: &ws.laws,
+        mobile: &mobile,
+        exerts: &exerts,
+    };
+    let mut m = std::mem::take(&mut ws.moments);
+    m.resize(ws.positions.len(), DVec3::ZERO);
+    ws.model.moments(&ws.positions, &view, &mut m);
+    ws.moments = m;
+    ws.cells = ws.model.cells(&ws.positions, &view);
+}
+
+fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
+    ws: &BrownianWorkspace,
+    values: &[DVec3],
+    q: &mut Query<&mut T>,
+    set: impl Fn(&mut T, DVec3),
+) {
+    for (e, v) in ws.entities.iter().zip(values) {
+        if let Ok(mut c) = q.get_mut(*e) {
+            set(&mut c, *v);
+        }
+    }
+}
+
+/// Field forces and moments.
+pub fn compute_field_forces(
+    ws: Res<BrownianWorkspace>,
+    mut forces: Query<&mut FieldForce>,
+    mut moments: Query<&mut MagneticMoment>,
+) {
+    let mobile = ws.mobile();
+    let view = ParticleView {
+        radii: &ws.radii,
+        moments: &ws.laws,
+        mobile: &mobile,
+        exerts: &mobile,
+    };
+    let mut f = vec![DVec3::ZERO; ws.positions.len()];
+    ws.model.field_forces(&ws.positions, &view, &mut f);
+    write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws, &ws.moments, &mut moments, |c, v| c.0 = v);
+}
+
+/// Dipole-dipole forces.
+pub fn compute_dipole_forces(
+    ws: Res<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    mut forces: Query<&mut DipoleForce>,
+) {
+    let (mobile, exerts) = (ws.mobile(), ws.exerts(&config));
+    let view = ParticleView {
+        radii: &ws.radii,
+        moments: &ws.laws,
+        mobile: &mobile,
+        exerts: &exerts,
+    };
+    let mut f = vec![DVec3::ZERO; ws.positions.len()];
+    ws.model
+        .dipole_forces(&ws.positions, &ws.moments, &view, ws.cells.as_ref(), &mut f);
+    write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
+}
+
+/// Mie contact forces.
+pub fn compute_contact_forces(
+    ws: Res<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    mut forces: Query<&mut ContactForce>,
+) {
+    let (mobile, exerts) = (ws.mobile(), ws.exerts(&config));
+    let view = ParticleView {
+        radii: &ws.radii,
+        moments: &ws.laws,
+        mobile: &mobile,
+        exerts: &exerts,
+    };
+    let mut f = vec![DVec3::ZERO; ws.positions.len()];
+    ws.model
+        .contact_forces(&ws.positions, &view, ws.cells.as_ref(), &mut f);
+    write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
+}
+
+/// Build this step's mobility over the free particles (nothing for free draining).
+pub fn prepare_mobility(
+    mut ws: ResMut<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    mut stats: ResMut<BrownianStats>,
+    mut health: ResMut<Health>,
+) {
+    let ws = &mut *ws;
+    ws.hydro = None;
+    if ws.method == MobilityMethod::FreeDraining {
+        return;
+    }
+    let rows: Vec<usize> = (0..ws.positions.len())
+        .filter(|&i| ws.captured[i].is_none())
+        .collect();
+    if rows.is_empty() {
+        return;
+    }
+    let x: Vec<DVec3> = rows.iter().map(|&i| ws.positions[i]).collect();
+    let a: Vec<f64> = rows.iter().map(|&i| ws.radii[i]).collect();
+    match Mobility::new(ws.method, &x, &a, config.viscosity, config.krylov_tolerance) {
+        Ok(mobility) => {
+            stats.krylov_iterations += mobility.krylov_iterations() as u64;
+            ws.hydro = Some(HydroState { mobility, rows });
+        }
+        Err(e) => health.report(format!("mobility ({:?}): {e}", ws.method)),
+    }
+}
+
+type ForceRow<'a> = (
+    &'a NetForce,
+    Option<&'a FieldForce>,
+    Option<&'a DipoleForce>,
+    Option<&'a ContactForce>,
+);
+
+/// One step of the stepper from the accumulated forces.
+pub fn integrate_brownian(
+    mut ws: ResMut<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    clock: Res<StepClock>,
+    mut stats: ResMut<BrownianStats>,
+    mut health: ResMut<Health>,
+    forces: Query<ForceRow>,
+) {
+    let ws = &mut *ws;
+    let n = ws.positions.len();
+    let mut net = vec![DVec3::ZERO; n];
+    let mut extra = vec![DVec3::ZERO; n];
+    for (k, e) in ws.entities.iter().enumerate() {
+        if let Ok((f, a, b, c)) = forces.get(*e) {
+            let model = a.map(|v| v.0).unwrap_or_default()
+                + b.map(|v| v.0).unwrap_or_default()
+                + c.map(|v| v.0).unwrap_or_default();
+            net[k] = f.0;
+            extra[k] = f.0 - model;
+        }
+    }
+    let mut dynamics = PipelineDynamics {
+        model: &ws.model,
+        radii: &ws.radii,
+        laws: &ws.laws,
+        mobile: ws.captured.iter().map(Option::is_none).collect(),
+        captured_interact: config.captured_interact,
+        extra: &extra,
+        viscosity: config.viscosity,
+        kt: config.kt(),
+        hydro: ws.hydro.as_ref(),
+        hard_core: config.contact == ContactModel::HardCore,
+        step: clock.step,
+        captures: Vec::new(),
+        parts: Default::default(),
+        sweeps: 0,
+        failure: None,
+    };
+    let mut v0 = vec![DVec3::ZERO; n];
+    dynamics.velocities(&net, &mut v0);
+    let mut x = std::mem::take(&mut ws.positions);
+    advance(
+        &mut dynamics,
+        &mut x,
+        Some(v0),
+        clock.dt,
+        &config.step_control,
+        &mut ws.rngs,
+        &mut stats,
+    );
+    let captures = std::mem::take(&mut dynamics.captures);
+    stats.hard_core_sweeps += dynamics.sweeps;
+    if let Some(f) = dynamics.failure.take() {
+        health.report(format!("step {}: {f}", clock.step));
+    }
+    for (i, ev) in captures {
+        ws.captured[i] = Some(ev);
+    }
+    if let Some(i) = x.iter().position(|p| !p.is_finite()) {
+        health.report(format!(
+            "step {}: non-finite position of particle {i} (time step unstable?)",
+            clock.step
+        ));
+    }
+    ws.positions = x;
+}
+
+/// Copy positions, capture flags and random streams to the components.
+pub fn write_back_brownian(
+    ws: Res<BrownianWorkspace>,
+    mut q: Query<(&mut Position, Option<&mut Captured>, &mut ParticleRng)>,
+) {
+    for (k, e) in ws.entities.iter().enumerate() {
+        if let Ok((mut p, c, mut r)) = q.get_mut(*e) {
+            p.0 = ws.positions[k];
+            if let Some(mut c) = c {
+                c.0 = ws.captured[k];
+            }
+            r.0.clone_from(&ws.rngs[k]);
+        }
+    }
+}
+
+/// Whether this step samples the capture curve: every `observe_every` completed steps and the
+/// last (`Observe` runs after the clock advanced).
+pub fn should_sample(config: Res<BrownianConfig>, clock: Res<StepClock>) -> bool {
+    clock.step.is_multiple_of(config.observe_every.max(1)) || clock.step >= config.steps
+}
+
+/// Append `(completed steps, captured)` to the capture curve.
+pub fn observe_capture(
+    ws: Res<BrownianWorkspace>,
+    clock: Res<StepClock>,
+    mut curve: ResMut<CaptureCurve>,
+) {
+    let s = clock.step;
+    if curve.samples.last().is_some_and(|l| l.0 >= s) {
+        return;
+    }
+    curve.samples.push((s, ws.captured_count()));
+}
