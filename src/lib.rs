@@ -15,6 +15,7 @@
 
 pub mod bench;
 pub mod bench_field;
+pub mod brownian;
 pub mod chart;
 pub mod fieldtool;
 pub mod replay;

@@ -6,6 +6,7 @@ use std::time::Instant;
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_plugins::app::SimApp;
+use magsep_plugins::brownian::brownian_pipeline;
 use magsep_plugins::group::PipelineGroup;
 use magsep_plugins::packing::packing_pipeline;
 use magsep_plugins::record::{FibreShape, RecordError, RecordingMetadata, RecordingWriter};
@@ -82,7 +83,15 @@ impl Simulation {
                 .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
         }
         spawn_scene(scene, &mut app.world, seed)?;
-        let group = options.pipeline.clone().unwrap_or_else(packing_pipeline);
+        let brownian = scene.brownian_section().is_some();
+        let pipeline = if brownian { "brownian" } else { "packing" };
+        let group = options.pipeline.clone().unwrap_or_else(|| {
+            if brownian {
+                brownian_pipeline()
+            } else {
+                packing_pipeline()
+            }
+        });
         group.build(&mut app);
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
         if let Some(path) = &options.record {
@@ -90,7 +99,7 @@ impl Simulation {
                 scene_text: scene.text.clone(),
                 seed,
                 version: env!("CARGO_PKG_VERSION").to_string(),
-                pipeline: "packing".into(),
+                pipeline: pipeline.into(),
                 schedule: app.resolved_schedule(),
                 dt: app.world.resource::<StepClock>().dt,
             };
@@ -128,7 +137,7 @@ impl Simulation {
         }
         Ok(Self {
             app,
-            pipeline: "packing".into(),
+            pipeline: pipeline.into(),
             seed,
             started: Instant::now(),
         })
@@ -141,6 +150,9 @@ impl Simulation {
 
     /// Whether the run has ended.
     pub fn is_finished(&self) -> bool {
+        if let Some(c) = self.app.world.get_resource::<BrownianConfig>() {
+            return self.app.world.resource::<StepClock>().step >= c.steps;
+        }
         self.app
             .world
             .get_resource::<PackingStatus>()
@@ -171,6 +183,13 @@ impl Simulation {
 
     /// The JSON summary of the current state.
     pub fn summary(&self) -> serde_json::Value {
+        if self.pipeline == "brownian" {
+            return crate::brownian::run_summary(
+                &self.app.world,
+                self.seed,
+                self.started.elapsed().as_secs_f64(),
+            );
+        }
         packing_summary(
             &self.app.world,
             self.seed,

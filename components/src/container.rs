@@ -19,6 +19,8 @@ pub enum Container {
         /// Edge lengths [m].
         edges: DVec3,
     },
+    /// Unbounded fluid (the Brownian pipeline around fibres): no walls, no periodicity.
+    Unbounded,
 }
 
 impl Container {
@@ -26,13 +28,15 @@ impl Container {
     pub fn volume(&self) -> f64 {
         match self {
             Container::PeriodicBox { edges } => edges.x * edges.y * edges.z,
+            Container::Unbounded => f64::INFINITY,
         }
     }
 
-    /// Edge lengths of the periodic box [m].
+    /// Edge lengths of the periodic box [m] (zero when unbounded).
     pub fn edges(&self) -> DVec3 {
         match self {
             Container::PeriodicBox { edges } => *edges,
+            Container::Unbounded => DVec3::ZERO,
         }
     }
 }

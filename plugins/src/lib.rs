@@ -7,11 +7,13 @@
 //! * [`group`]: [`group::PipelineGroup`]: add, disable, replace plugins.
 //! * [`core`]: clock and health.
 //! * [`packing`]: the `packing` pipeline.
+//! * [`brownian`]: the `brownian` pipeline.
 //! * [`recorder`] and [`record`]: recordings.
 
 #![warn(missing_docs)]
 
 pub mod app;
+pub mod brownian;
 pub mod core;
 pub mod group;
 pub mod packing;

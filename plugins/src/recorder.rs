@@ -3,7 +3,9 @@
 //!
 //! | set | system | touches |
 //! |---|---|---|
-//! | `Record` | [`record_frame`] | `Recorder`; reads particles, `StepClock`, `Container`, `PackingStatus`, `McmWorkspace` |
+//! | `Record` | [`record_frame`] | `Recorder`; reads particles, `StepClock`, `Container`, `PackingStatus`, `McmWorkspace`, `BrownianConfig`, `BrownianStats` |
+//!
+//! Brownian runs colour captured particles [`CAPTURED_COLOUR`] and free ones [`FREE_COLOUR`].
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
@@ -35,7 +37,27 @@ pub struct FrameStatus {
     pub packing: Option<PackingStatus>,
     /// Packing driver random stream (xoshiro256++ words).
     pub driver_rng: Option<[u64; 4]>,
+    /// Brownian pipeline state beyond positions and random streams.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub brownian: Option<BrownianFrameStatus>,
 }
+
+/// Brownian state of a frame (with the positions and streams of the frame: a lossless
+/// checkpoint for `--resume`). Arrays in `ParticleId` order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct BrownianFrameStatus {
+    /// Capture of each particle (step and fibre), `null` while free.
+    pub captured: Vec<Option<CaptureEvent>>,
+    /// Start positions [m] (for displacements and the Brownian criterion).
+    pub initial_positions: Vec<[f64; 3]>,
+    /// Stepper counters so far.
+    pub stats: BrownianStats,
+}
+
+/// Colour of a free particle in the viewer (RGBA).
+pub const FREE_COLOUR: [f32; 4] = [0.35, 0.55, 0.85, 1.0];
+/// Colour of a captured particle in the viewer (RGBA).
+pub const CAPTURED_COLOUR: [f32; 4] = [0.9, 0.25, 0.15, 1.0];
 
 /// Writes frames.
 #[derive(Debug, Clone, Copy, Default)]
@@ -63,6 +85,8 @@ type FrameQuery<'w, 's> = Query<
         &'static Orientation,
         &'static Shape,
         &'static ParticleRng,
+        Option<&'static Captured>,
+        Option<&'static InitialPosition>,
     ),
 >;
 
@@ -72,6 +96,7 @@ pub fn gather_frame(
     container: &Container,
     status: Option<&PackingStatus>,
     ws: Option<&McmWorkspace>,
+    brownian: Option<&BrownianStats>,
     q: &FrameQuery,
 ) -> ParticleFrame {
     let mut rows: Vec<_> = q.iter().collect();
@@ -79,6 +104,14 @@ pub fn gather_frame(
     let fs = FrameStatus {
         packing: status.copied(),
         driver_rng: ws.map(|w| rng_state_words(&w.rng)),
+        brownian: brownian.map(|stats| BrownianFrameStatus {
+            captured: rows.iter().map(|r| r.5.and_then(|c| c.0)).collect(),
+            initial_positions: rows
+                .iter()
+                .map(|r| r.6.map(|p| p.0.to_array()).unwrap_or_default())
+                .collect(),
+            stats: stats.clone(),
+        }),
     };
     ParticleFrame {
         step: clock.step,
@@ -101,6 +134,8 @@ pub fn record_frame(
     container: Res<Container>,
     status: Option<Res<PackingStatus>>,
     ws: Option<Res<McmWorkspace>>,
+    brownian: Option<Res<BrownianConfig>>,
+    stats: Option<Res<BrownianStats>>,
     q: FrameQuery,
 ) {
     if rec.writer.is_none() || rec.last_step == Some(clock.step) {
@@ -109,12 +144,39 @@ pub fn record_frame(
     let stopped = status
         .as_ref()
         .map(|s| s.stopped.is_some())
-        .unwrap_or(false);
+        .unwrap_or(false)
+        || brownian.as_ref().is_some_and(|c| clock.step >= c.steps);
     if !(stopped || clock.step.is_multiple_of(rec.every.max(1))) {
         return;
     }
-    let frame = gather_frame(&clock, &container, status.as_deref(), ws.as_deref(), &q);
-    let result = rec.writer.as_mut().map(|w| w.write_frame(&frame, None));
+    let stats = brownian
+        .as_ref()
+        .map(|_| stats.as_deref().cloned().unwrap_or_default());
+    let frame = gather_frame(
+        &clock,
+        &container,
+        status.as_deref(),
+        ws.as_deref(),
+        stats.as_ref(),
+        &q,
+    );
+    let colours: Option<Vec<[f32; 4]>> = brownian.as_ref().map(|_| {
+        let mut rows: Vec<_> = q.iter().map(|r| (*r.0, r.5.and_then(|c| c.0))).collect();
+        rows.sort_by_key(|r| r.0);
+        rows.iter()
+            .map(|r| {
+                if r.1.is_some() {
+                    CAPTURED_COLOUR
+                } else {
+                    FREE_COLOUR
+                }
+            })
+            .collect()
+    });
+    let result = rec
+        .writer
+        .as_mut()
+        .map(|w| w.write_frame(&frame, colours.as_deref()));
     match result {
         Some(Err(e)) => {
             rec.error = Some(e.to_string());

@@ -55,6 +55,9 @@ pub fn run(
         pipeline: None,
         single_threaded: single,
     };
+    if let Some(section) = scene.brownian_section() {
+        return run_brownian(&scene, section, &options, quiet);
+    }
     let mut sim = Simulation::from_scene(&scene, options).map_err(|e| match e {
         magsep::sim::SimError::NothingToRun => CliError::input(e.to_string()),
         e => CliError::runtime(e.to_string()),
@@ -89,5 +92,36 @@ pub fn run(
             "no compression step succeeded: the volume step is too large for the attempt budget (see warnings)",
         ));
     }
+    Ok(())
+}
+
+/// A brownian scene: `runs` replicates in parallel with one progress bar over all steps.
+fn run_brownian(
+    scene: &magsep::scene::Scene,
+    section: &magsep::scene::BrownianSection,
+    options: &RunOptions,
+    quiet: bool,
+) -> Result<(), CliError> {
+    let runs = section.runs();
+    let total = section.steps() * runs;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "[{elapsed_precise}] {bar:40} {pos}/{len} steps ({eta} left) {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("{runs} run(s)"));
+    let summary = magsep::brownian::run_ensemble(scene, runs, options, &|n| bar.inc(n))
+        .map_err(|e| CliError::runtime(e.to_string()))?;
+    bar.finish_and_clear();
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&summary).unwrap_or_default()
+    );
     Ok(())
 }

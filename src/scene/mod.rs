@@ -16,7 +16,9 @@
 //! assert_eq!(errors.0[0].path, "particles[0].shape.radius");
 //! ```
 
+mod brownian;
 mod fibres;
+mod placement;
 mod sections;
 mod spawn;
 #[cfg(test)]
@@ -28,6 +30,7 @@ use std::path::Path;
 
 use bevy_ecs::prelude::*;
 
+pub use brownian::{BrownianSection, PlacementSpec};
 pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use sections::{
     ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec,
@@ -135,6 +138,8 @@ pub struct Scene {
     pub packing: PackingSection,
     /// `[record]`.
     pub record: Option<RecordSection>,
+    /// `[brownian]` (the brownian pipeline).
+    pub brownian: Option<BrownianSection>,
     /// Plugin kinds: (key, value) in file order.
     pub extensions: Vec<(String, toml::Value)>,
 }
@@ -148,6 +153,7 @@ pub const CORE_KEYS: &[&str] = &[
     "record",
     "fibres",
     "external_field",
+    "brownian",
 ];
 
 /// Parse and validate a scene; every problem is reported.
@@ -183,6 +189,17 @@ impl Scene {
             .unwrap_or((glam::DVec3::ZERO, magsep_systems::field::EXACT));
         let sources = self.fibres.iter().map(|f| f.source(b_ext)).collect();
         (sources, b_ext, tol)
+    }
+
+    /// The `[brownian]` section when the scene runs the brownian pipeline.
+    pub fn brownian_section(&self) -> Option<&BrownianSection> {
+        match &self.simulation {
+            Some(SimulationSection {
+                pipeline: PipelineKind::Brownian,
+                ..
+            }) => self.brownian.as_ref(),
+            _ => None,
+        }
     }
 
     /// Whether this is a field-only scene (fibres and an external field, nothing to run).

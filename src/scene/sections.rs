@@ -12,6 +12,8 @@ use super::Scene;
 pub enum PipelineKind {
     /// Mechanical contraction (random dense packings).
     Packing,
+    /// Brownian dynamics of magnetic nanoparticles around magnetised fibres.
+    Brownian,
 }
 
 /// `[simulation]`.
@@ -76,6 +78,12 @@ pub struct ParticleGroup {
     pub count: u64,
     /// Shape.
     pub shape: ShapeSpec,
+    /// Magnetic moment law (brownian pipeline). Default: non-magnetic.
+    #[serde(default)]
+    pub moment: Option<magsep_components::brownian::MomentModel>,
+    /// Start region (brownian pipeline; required there).
+    #[serde(default)]
+    pub placement: Option<super::brownian::PlacementSpec>,
 }
 
 /// `[packing]`: every key optional (see `PackingConfig` for meanings and defaults).

@@ -50,6 +50,45 @@ pub fn spawn_scene_with(
     seed: u64,
     registry: &SceneRegistry,
 ) -> Result<(), SpawnError> {
+    if let Some(section) = scene.brownian_section() {
+        super::placement::spawn_brownian(scene, section, world, seed)?;
+    } else {
+        spawn_packing_particles(scene, world, seed)?;
+    }
+    world.insert_resource(RunSeed(seed));
+    world.insert_resource(Health::default());
+    world.insert_resource(SceneText(scene.text.clone()));
+    world.insert_resource(RecordEvery(
+        scene.record.as_ref().map(|r| r.every).unwrap_or(100),
+    ));
+    // fibres as entities, and the applied field
+    let (sources, b_ext, tolerance) = scene.field_sources();
+    for (i, s) in sources.iter().enumerate() {
+        world.spawn((
+            FibreId(i as u64),
+            Fibre {
+                center: s.center,
+                axis: s.axis(),
+                radius: s.radius,
+                half_length: s.half_length,
+                magnetisation: s.magnetisation,
+            },
+        ));
+    }
+    world.insert_resource(ExternalField {
+        flux_density: b_ext,
+        tolerance,
+    });
+    for (key, value) in &scene.extensions {
+        if let Some(kind) = registry.get(key) {
+            kind.spawn(value, world)?;
+        }
+    }
+    Ok(())
+}
+
+/// Random non-overlapping particles in the periodic cube at the initial packing fraction.
+fn spawn_packing_particles(scene: &Scene, world: &mut World, seed: u64) -> Result<(), SpawnError> {
     let shapes = scene.shapes();
     let config = scene.packing_config();
     let d = scene.reference_diameter();
@@ -83,34 +122,5 @@ pub fn spawn_scene_with(
     });
     world.insert_resource(config);
     world.insert_resource(StepClock::new(0.0));
-    world.insert_resource(RunSeed(seed));
-    world.insert_resource(Health::default());
-    world.insert_resource(SceneText(scene.text.clone()));
-    world.insert_resource(RecordEvery(
-        scene.record.as_ref().map(|r| r.every).unwrap_or(100),
-    ));
-    // fibres as entities, and the applied field
-    let (sources, b_ext, tolerance) = scene.field_sources();
-    for (i, s) in sources.iter().enumerate() {
-        world.spawn((
-            FibreId(i as u64),
-            Fibre {
-                center: s.center,
-                axis: s.axis(),
-                radius: s.radius,
-                half_length: s.half_length,
-                magnetisation: s.magnetisation,
-            },
-        ));
-    }
-    world.insert_resource(ExternalField {
-        flux_density: b_ext,
-        tolerance,
-    });
-    for (key, value) in &scene.extensions {
-        if let Some(kind) = registry.get(key) {
-            kind.spawn(value, world)?;
-        }
-    }
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 use serde::de::DeserializeOwned;
 
+use super::brownian::{BrownianSection, validate_group, validate_section};
 use super::fibres::{ExternalFieldSection, FibreSpec, validate_fibres};
 use super::sections::*;
 use super::{CORE_KEYS, Scene, SceneError, SceneRegistry};
@@ -145,6 +146,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut extensions = Vec::new();
     let mut fibres = Vec::new();
     let mut external_field = None;
+    let mut brownian = None;
     for (key, value) in &table {
         match key.as_str() {
             "simulation" => {
@@ -155,6 +157,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 packing = typed::<PackingSection>(value, "packing", &mut errors).unwrap_or_default()
             }
             "record" => record = typed::<RecordSection>(value, "record", &mut errors),
+            "brownian" => brownian = typed::<BrownianSection>(value, "brownian", &mut errors),
             "external_field" => {
                 external_field = typed::<ExternalFieldSection>(value, "external_field", &mut errors)
             }
@@ -189,12 +192,47 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             "missing required table [simulation]",
         ));
     }
-    if !field_only && !table.contains_key("container") {
+    let is_brownian = matches!(
+        simulation,
+        Some(SimulationSection {
+            pipeline: PipelineKind::Brownian,
+            ..
+        })
+    );
+    if !field_only && !is_brownian && !table.contains_key("container") {
         errors.push(SceneError::new(
             "container",
             "missing required table [container]",
         ));
     }
+    if is_brownian {
+        if table.contains_key("container") {
+            errors.push(SceneError::new(
+                "container",
+                "the brownian pipeline runs in unbounded fluid around the fibres: remove [container]",
+            ));
+        }
+        match &brownian {
+            Some(b) => validate_section(b, &mut errors),
+            None if !table.contains_key("brownian") => errors.push(SceneError::new(
+                "brownian",
+                "missing required table [brownian] (time_step, duration)",
+            )),
+            None => {}
+        }
+        if !table.contains_key("particles") {
+            errors.push(SceneError::new(
+                "particles",
+                "the brownian pipeline needs at least one [[particles]] entry",
+            ));
+        }
+    } else if brownian.is_some() {
+        errors.push(SceneError::new(
+            "brownian",
+            "only for pipeline = \"brownian\"",
+        ));
+    }
+    let fibre_specs: Vec<FibreSpec> = fibres.iter().map(|(_, f)| f.clone()).collect();
     // semantic checks
     let mut total: u64 = 0;
     for (i, g) in &particles {
@@ -203,6 +241,35 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             format!("must be >= 1, got {}", g.count)
         });
         total = total.saturating_add(g.count);
+        if is_brownian {
+            match g.shape {
+                ShapeSpec::Sphere { radius } => validate_group(
+                    &p,
+                    g.count,
+                    radius,
+                    g.moment.as_ref(),
+                    g.placement.as_ref(),
+                    &fibre_specs,
+                    &mut errors,
+                ),
+                _ => errors.push(SceneError::new(
+                    format!("{p}.shape.kind"),
+                    "the brownian pipeline simulates spheres only",
+                )),
+            }
+        } else {
+            for (key, present) in [
+                ("moment", g.moment.is_some()),
+                ("placement", g.placement.is_some()),
+            ] {
+                if present {
+                    errors.push(SceneError::new(
+                        format!("{p}.{key}"),
+                        "only for pipeline = \"brownian\"",
+                    ));
+                }
+            }
+        }
         match g.shape {
             ShapeSpec::Sphere { radius } => {
                 finite_positive(&mut errors, &format!("{p}.shape.radius"), radius)
@@ -288,7 +355,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     validate_fibres(&fibres, external_field.as_ref(), &mut errors);
     match (simulation, container, errors.is_empty()) {
         (simulation, container, true)
-            if field_only || (simulation.is_some() && container.is_some()) =>
+            if field_only || (simulation.is_some() && (container.is_some() || is_brownian)) =>
         {
             Ok(Scene {
                 text: text.to_string(),
@@ -299,6 +366,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 particles: particles.into_iter().map(|(_, g)| g).collect(),
                 packing,
                 record,
+                brownian,
                 extensions,
             })
         }

@@ -154,7 +154,10 @@ pub(crate) fn scene_update(
         }],
         ..entity(BOX_ENTITY)
     };
-    let mut entities = vec![particles, outline];
+    let mut entities = vec![particles];
+    if frame.box_edges.min_element() > 0.0 {
+        entities.push(outline);
+    }
     if !fibres.is_empty() {
         entities.push(SceneEntity {
             cylinders: fibres

@@ -83,8 +83,7 @@ impl CellList {
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    let Some(&(a, b)) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz])
-                    else {
+                    let Some(&(a, b)) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
                         continue;
                     };
                     for &j in &self.order[a as usize..b as usize] {

@@ -96,7 +96,12 @@ pub fn swept_capture(
 
 /// Push overlapping pairs apart (see the module header). `mobile[i]` particles move; pairs of
 /// two fixed particles are left alone. Returns the number of sweeps (0: nothing overlapped).
-pub fn remove_overlaps(x: &mut [DVec3], radii: &[f64], mobile: &[bool], max_sweeps: usize) -> usize {
+pub fn remove_overlaps(
+    x: &mut [DVec3],
+    radii: &[f64],
+    mobile: &[bool],
+    max_sweeps: usize,
+) -> usize {
     let amax = radii.iter().copied().fold(0.0, f64::max);
     if amax == 0.0 || x.len() < 2 {
         return 0;
@@ -153,16 +158,34 @@ mod tests {
         let a = 0.05;
         // grazing pass: the segment's closest approach to the lateral surface is 1.04 < 1.05
         let y = 1.04;
-        let hit = swept_capture(std::slice::from_ref(&f), DVec3::new(-3.0, y, 0.0), DVec3::new(3.0, y, 0.0), a);
+        let hit = swept_capture(
+            std::slice::from_ref(&f),
+            DVec3::new(-3.0, y, 0.0),
+            DVec3::new(3.0, y, 0.0),
+            a,
+        );
         let (_, p) = hit.expect("grazing contact missed");
         assert!((f.distance(p) - a).abs() < 1e-6 * a);
         assert!(p.x < 0.0, "first contact is on the entry side: {p}");
         // a miss by a hair
         let y = 1.0 + a + 1e-4;
-        assert!(swept_capture(std::slice::from_ref(&f), DVec3::new(-3.0, y, 0.0), DVec3::new(3.0, y, 0.0), a).is_none());
+        assert!(
+            swept_capture(
+                std::slice::from_ref(&f),
+                DVec3::new(-3.0, y, 0.0),
+                DVec3::new(3.0, y, 0.0),
+                a
+            )
+            .is_none()
+        );
         // falling onto the end face
-        let (_, p) =
-            swept_capture(std::slice::from_ref(&f), DVec3::new(0.3, 0.0, 4.0), DVec3::new(0.3, 0.0, 1.0), a).unwrap();
+        let (_, p) = swept_capture(
+            std::slice::from_ref(&f),
+            DVec3::new(0.3, 0.0, 4.0),
+            DVec3::new(0.3, 0.0, 1.0),
+            a,
+        )
+        .unwrap();
         assert!((p.z - 2.05).abs() < 1e-6);
         // brute force on random segments
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);

@@ -118,7 +118,8 @@ impl Dynamics for PipelineDynamics<'_> {
             None => {
                 for i in 0..w.len() {
                     out[i] = if self.mobile[i] {
-                        let mu = 1.0 / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]);
+                        let mu =
+                            1.0 / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]);
                         w[i] * (2.0 * self.kt * mu).sqrt()
                     } else {
                         DVec3::ZERO

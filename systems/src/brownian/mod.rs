@@ -3,11 +3,11 @@
 //! * [`hydro`]: mobilities (free draining, Rotne-Prager-Yamakawa) and Brownian displacements
 //!   (dense Cholesky, TEA-HI, Krylov/Lanczos square root).
 
-pub mod hydro;
 pub mod cells;
+pub mod contact;
+pub mod dynamics;
+pub mod hydro;
 pub mod model;
 pub mod pair;
 pub mod stepper;
-pub mod contact;
-pub mod dynamics;
 pub mod systems;

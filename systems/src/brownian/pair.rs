@@ -181,7 +181,11 @@ mod tests {
         let mut hi = rmin;
         for _ in 0..100 {
             let mid = 0.5 * (lo + hi);
-            if mie.energy(mid) > 1.0 { lo = mid } else { hi = mid }
+            if mie.energy(mid) > 1.0 {
+                lo = mid
+            } else {
+                hi = mid
+            }
         }
         assert!((lo - 2.081).abs() < 1e-3, "{lo}");
     }
@@ -221,7 +225,9 @@ mod tests {
         assert!((f.x + 0.5 * expect).abs() < 1e-14 * expect.abs());
         // energies: −2 and +1 in units of μ0 m²/(4π r³)
         let u0 = MU0 * m * m / (4.0 * std::f64::consts::PI * r.powi(3));
-        assert!((dipole_energy(DVec3::Z * r, DVec3::Z * m, DVec3::Z * m) + 2.0 * u0).abs() < 1e-12 * u0);
+        assert!(
+            (dipole_energy(DVec3::Z * r, DVec3::Z * m, DVec3::Z * m) + 2.0 * u0).abs() < 1e-12 * u0
+        );
         assert!((dipole_energy(DVec3::X * r, DVec3::Z * m, DVec3::Z * m) - u0).abs() < 1e-12 * u0);
     }
 }

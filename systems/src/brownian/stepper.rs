@@ -62,11 +62,7 @@ fn normal3(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
 }
 
 /// Wiener increments over `h` for the mobile particles (zero for the others).
-pub fn wiener_increments(
-    mobile: &[bool],
-    h: f64,
-    rngs: &mut [Xoshiro256PlusPlus],
-) -> Vec<DVec3> {
+pub fn wiener_increments(mobile: &[bool], h: f64, rngs: &mut [Xoshiro256PlusPlus]) -> Vec<DVec3> {
     let s = h.sqrt();
     mobile
         .iter()
@@ -123,7 +119,13 @@ pub fn advance<D: Dynamics>(
             .iter()
             .zip(rngs.iter_mut())
             .zip(&mobile)
-            .map(|((&wi, rng), &m)| if m { wi * 0.5 + normal3(rng) * s } else { DVec3::ZERO })
+            .map(|((&wi, rng), &m)| {
+                if m {
+                    wi * 0.5 + normal3(rng) * s
+                } else {
+                    DVec3::ZERO
+                }
+            })
             .collect();
         let wr: Vec<DVec3> = w.iter().zip(&wl).map(|(a, l)| *a - *l).collect();
         dynamics.noise(&wl, &mut bl);

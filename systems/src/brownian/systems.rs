@@ -105,7 +105,10 @@ fn bounding_volume_fraction(x: &[DVec3], radii: &[f64]) -> f64 {
         lo = lo.min(*p - DVec3::splat(*a));
         hi = hi.max(*p + DVec3::splat(*a));
     }
-    let v: f64 = radii.iter().map(|a| 4.0 / 3.0 * std::f64::consts::PI * a.powi(3)).sum();
+    let v: f64 = radii
+        .iter()
+        .map(|a| 4.0 / 3.0 * std::f64::consts::PI * a.powi(3))
+        .sum();
     (v / (hi - lo).element_product()).min(1.0)
 }
 
@@ -134,7 +137,15 @@ pub fn init_brownian_workspace(world: &mut World) {
         .query::<Row>()
         .iter(world)
         .map(|(e, id, p, s, m, c, r)| {
-            (*id, e, p.0, s.radius(), m.copied().unwrap_or_default(), c.and_then(|c| c.0), r.0.clone())
+            (
+                *id,
+                e,
+                p.0,
+                s.radius(),
+                m.copied().unwrap_or_default(),
+                c.and_then(|c| c.0),
+                r.0.clone(),
+            )
         })
         .collect();
     rows.sort_by_key(|r| r.0);
@@ -148,7 +159,10 @@ pub fn init_brownian_workspace(world: &mut World) {
         MobilityChoice::Tea => (MobilityMethod::Tea, "chosen in the scene"),
         MobilityChoice::Krylov => (MobilityMethod::Krylov, "chosen in the scene"),
     };
-    let mut stats = world.get_resource::<BrownianStats>().cloned().unwrap_or_default();
+    let mut stats = world
+        .get_resource::<BrownianStats>()
+        .cloned()
+        .unwrap_or_default();
     stats.mobility = serde_json::to_value(method)
         .ok()
         .and_then(|v| v.as_str().map(str::to_string))
@@ -168,7 +182,10 @@ pub fn init_brownian_workspace(world: &mut World) {
         hydro: None,
         method,
     });
-    let step = world.get_resource::<StepClock>().map(|c| c.step).unwrap_or(0);
+    let step = world
+        .get_resource::<StepClock>()
+        .map(|c| c.step)
+        .unwrap_or(0);
     let captured = world.resource::<BrownianWorkspace>().captured_count();
     let mut curve = world.get_resource_or_init::<CaptureCurve>();
     if curve.samples.is_empty() {

@@ -69,7 +69,10 @@ fn free_particle_msd_is_6dt_fixed_and_adaptive() {
     assert!((m / (6.0 * t) - 1.0).abs() < 0.02, "fixed: {m}");
     // a small displacement cap forces deep bisection of the same path: statistics unchanged
     let (m, stats) = msd(adaptive(1e-3, 0.3), n, steps, dt);
-    assert!(stats.rejections > 0 && stats.max_depth_reached >= 4, "{stats:?}");
+    assert!(
+        stats.rejections > 0 && stats.max_depth_reached >= 4,
+        "{stats:?}"
+    );
     assert!((m / (6.0 * t) - 1.0).abs() < 0.02, "adaptive: {m}");
 }
 
@@ -118,7 +121,10 @@ fn stiff_trap_fixed_step_diverges_adaptive_is_stable_with_boltzmann_variance() {
     let (var, stats) = run(adaptive(1e-3, 0.5));
     // Boltzmann: <x²> = kT / k = 0.2 per component (Euler's own bias ~ mu k h / 2 is small at
     // the accepted sub-steps); standard error sqrt(2/12000) = 1.3 %
-    assert!((var / 0.2 - 1.0).abs() < 0.05, "adaptive variance {var}, {stats:?}");
+    assert!(
+        (var / 0.2 - 1.0).abs() < 0.05,
+        "adaptive variance {var}, {stats:?}"
+    );
     assert!(stats.depth_limit_hits == 0);
 }
 
@@ -133,7 +139,15 @@ fn deterministic_error_decreases_with_tolerance() {
         let mut x = vec![DVec3::new(3.0, 0.0, 0.0)];
         let mut rngs = vec![particle_stream(0, 0)];
         let mut stats = BrownianStats::default();
-        advance(&mut d, &mut x, None, 1.0, &adaptive(tol, 10.0), &mut rngs, &mut stats);
+        advance(
+            &mut d,
+            &mut x,
+            None,
+            1.0,
+            &adaptive(tol, 10.0),
+            &mut rngs,
+            &mut stats,
+        );
         let e = (x[0].x - exact).abs();
         assert!(e < last, "tol {tol}: error {e} >= {last}");
         eprintln!("tol {tol}: error {e}, substeps {}", stats.substeps);

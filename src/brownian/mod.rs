@@ -1,0 +1,8 @@
+//! The brownian pipeline's facade: summaries of runs and ensembles, replay of capture curves.
+
+pub mod ensemble;
+pub mod stats;
+pub mod summary;
+
+pub use ensemble::run_ensemble;
+pub use summary::{RunResult, StartRegions, run_result, run_summary, summary_of};
