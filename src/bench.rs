@@ -146,9 +146,12 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
     if what == "field" {
         return crate::bench_field::bench_field(as_json, quick);
     }
+    if what == "brownian" {
+        return crate::bench_brownian::bench_brownian(as_json, quick);
+    }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown benchmark `{what}`; available: packing, field"
+            "unknown benchmark `{what}`; available: packing, field, brownian"
         )));
     }
     let threads = rayon::current_num_threads();
@@ -239,6 +242,12 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
 /// # Errors
 /// [`BenchError::Input`] for an unknown chart, [`BenchError::Runtime`] for I/O.
 pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
+    if what == "brownian-cost" {
+        return crate::bench_brownian::chart_brownian_cost(out, quick);
+    }
+    if what == "brownian" {
+        return crate::brownian::chart::chart_brownian(out, quick);
+    }
     if what == "field" {
         let rows = crate::bench_field::chart_field(out, quick)?;
         println!(
@@ -249,7 +258,7 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
     }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown chart `{what}`; available: packing, field"
+            "unknown chart `{what}`; available: packing, field, brownian, brownian-cost"
         )));
     }
     std::fs::create_dir_all(out)

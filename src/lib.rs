@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod bench_brownian;
 pub mod bench_field;
 pub mod brownian;
 pub mod chart;

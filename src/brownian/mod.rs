@@ -1,5 +1,6 @@
 //! The brownian pipeline's facade: summaries of runs and ensembles, replay of capture curves.
 
+pub mod chart;
 pub mod ensemble;
 pub mod stats;
 pub mod summary;
