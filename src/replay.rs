@@ -107,6 +107,10 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
     let rec = read_recording(path)?;
     let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
     let scene = parse_scene(&meta.scene_text, &Default::default())?;
+    if scene.brownian_section().is_some() {
+        let summary = crate::brownian::replay::replay_brownian(&rec, &scene, meta.seed)?;
+        return Ok((summary, rec));
+    }
     let frame = rec.frames.last().ok_or_else(|| {
         ReplayError::NoFrames(
             rec.truncated

@@ -30,6 +30,9 @@ pub enum SimError {
     /// The scene has no `[simulation]` (a field-only scene: use `magsep field`).
     #[error("the scene has no [simulation] to run (a field-only scene: use `magsep field`)")]
     NothingToRun,
+    /// The frame to resume from does not fit the scene.
+    #[error("cannot resume: {0}")]
+    Resume(String),
     /// A numerical failure was reported.
     #[error("numerical failure: {0}")]
     Health(String),
@@ -46,6 +49,8 @@ pub struct RunOptions {
     pub pipeline: Option<PipelineGroup>,
     /// Run the schedule on one thread.
     pub single_threaded: bool,
+    /// Continue from this recorded frame (brownian pipeline; see `magsep replay --resume`).
+    pub resume_from: Option<magsep_plugins::record::ParticleFrame>,
 }
 
 /// A simulation built from a scene.
@@ -83,6 +88,10 @@ impl Simulation {
                 .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
         }
         spawn_scene(scene, &mut app.world, seed)?;
+        if let Some(frame) = &options.resume_from {
+            crate::brownian::replay::apply_frame(&mut app.world, frame)
+                .map_err(|e| SimError::Resume(e.to_string()))?;
+        }
         let brownian = scene.brownian_section().is_some();
         let pipeline = if brownian { "brownian" } else { "packing" };
         let group = options.pipeline.clone().unwrap_or_else(|| {

@@ -54,6 +54,7 @@ pub fn run_ensemble(
             record: if k == 0 { options.record.clone() } else { None },
             pipeline: options.pipeline.clone(),
             single_threaded: options.single_threaded || runs > 1,
+            resume_from: None,
         };
         let mut sim = Simulation::from_scene(scene, opts)?;
         let last = AtomicU64::new(0);

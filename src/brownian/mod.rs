@@ -2,6 +2,7 @@
 
 pub mod chart;
 pub mod ensemble;
+pub mod replay;
 pub mod stats;
 pub mod summary;
 

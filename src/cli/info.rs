@@ -119,3 +119,34 @@ pub fn replay(path: &Path) -> Result<(), CliError> {
     );
     Ok(())
 }
+
+pub fn resume(path: &Path, record: Option<std::path::PathBuf>, quiet: bool) -> Result<(), CliError> {
+    let bar = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new_spinner()
+    };
+    let summary = magsep::brownian::replay::resume(path, record, |w| {
+        if let Some(c) = w.get_resource::<magsep::components::clock::StepClock>()
+            && c.step % 1000 == 0
+        {
+            bar.set_message(format!("step {}", c.step));
+            bar.tick();
+        }
+    })
+    .map_err(|e| match e {
+        magsep::brownian::replay::ResumeError::Replay(ReplayError::Record(r)) => {
+            record_error(path, r)
+        }
+        magsep::brownian::replay::ResumeError::Replay(other) => {
+            CliError::input(format!("{}: {other}", path.display()))
+        }
+        magsep::brownian::replay::ResumeError::Sim(e) => CliError::runtime(e.to_string()),
+    })?;
+    bar.finish_and_clear();
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&summary).unwrap_or_default()
+    );
+    Ok(())
+}

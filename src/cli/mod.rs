@@ -82,6 +82,16 @@ enum Command {
     Replay {
         /// MCAP recording.
         recording: PathBuf,
+        /// Continue the run from the recording's last frame to the scene's end (brownian),
+        /// bitwise as if never interrupted; prints the summary of the whole run.
+        #[arg(long)]
+        resume: bool,
+        /// With --resume: record the continuation here.
+        #[arg(long, requires = "resume")]
+        record: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Magnetic field of a scene's fibres: CSV at points, or a map in a plane.
     ///
@@ -188,7 +198,18 @@ pub fn main() -> i32 {
             })
         }),
         Command::Info { recording, json } => info::info(&recording, json),
-        Command::Replay { recording } => info::replay(&recording),
+        Command::Replay {
+            recording,
+            resume,
+            record,
+            quiet,
+        } => {
+            if resume {
+                info::resume(&recording, record, quiet)
+            } else {
+                info::replay(&recording)
+            }
+        }
         Command::Bench { what, json, quick } => {
             magsep::bench::bench(&what, json, quick).map_err(to_cli)
         }

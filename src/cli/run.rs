@@ -54,6 +54,7 @@ pub fn run(
         record,
         pipeline: None,
         single_threaded: single,
+        resume_from: None,
     };
     if let Some(section) = scene.brownian_section() {
         return run_brownian(&scene, section, &options, quiet);
