@@ -262,3 +262,47 @@ pub struct CaptureCurve {
     /// Samples `(step, captured particles)`, in step order.
     pub samples: Vec<(u64, u64)>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn langevin_limits_and_values() {
+        assert!((langevin(1.0) - 0.313_035_285_499_331).abs() < 1e-15);
+        for x in [1e-6, 1e-4, 9.9e-4] {
+            assert!((langevin(x) / x - 1.0 / 3.0).abs() < 1e-6, "{x}");
+        }
+        assert!((langevin(57.0) - (1.0 - 1.0 / 57.0)).abs() < 1e-15);
+        // continuity across the branch points
+        for x in [1e-3f64, 40.0] {
+            let (a, b) = (langevin(x * (1.0 - 1e-12)), langevin(x * (1.0 + 1e-12)));
+            assert!((a - b).abs() < 1e-12, "{x}");
+        }
+        assert_eq!(langevin(-2.0), -langevin(2.0));
+    }
+
+    #[test]
+    fn langevin_moment_is_the_derivative_of_the_free_energy() {
+        // |m|(B) = -dF/dB with F(B) = -kT (μs/μd) ln(sinh x / x), x = μd B / kT
+        let kt = BOLTZMANN * 298.0;
+        let (ms, md) = (0.87e-16, 2.3e-19);
+        let law = MomentModel::Langevin {
+            moment: ms,
+            domain_moment: md,
+        };
+        let free = |b: f64| {
+            let x = md * b / kt;
+            -kt * ms / md * (x.sinh() / x).ln()
+        };
+        for b in [0.005, 0.05, 0.2] {
+            let h = 1e-6 * b;
+            let m = -(free(b + h) - free(b - h)) / (2.0 * h);
+            assert!((law.magnitude(b, kt) / m - 1.0).abs() < 1e-6, "B = {b}");
+        }
+        // spec 2.4: a 10 nm magnetite core at 1 T: x ≈ 56, L ≈ 0.98; at 0.4 T L ≈ 0.96
+        assert!((law.magnitude(1.0, kt) / ms - 0.982).abs() < 0.002);
+        assert!((law.magnitude(0.4, kt) / ms - 0.955).abs() < 0.005);
+        assert_eq!(MomentModel::Saturated { moment: ms }.magnitude(0.1, kt), ms);
+    }
+}

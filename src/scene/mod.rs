@@ -22,6 +22,8 @@ mod placement;
 mod sections;
 mod spawn;
 #[cfg(test)]
+mod brownian_tests;
+#[cfg(test)]
 mod tests;
 mod validate;
 
