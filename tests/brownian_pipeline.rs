@@ -167,3 +167,45 @@ fn bitwise_identical_for_one_and_two_threads() {
     let b = run(2, false);
     assert!(a.iter().zip(&b).all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits)));
 }
+
+#[test]
+fn every_mobility_runs_in_the_pipeline_and_is_reported() {
+    for (method, expect) in [
+        ("cholesky", "cholesky"),
+        ("tea", "tea"),
+        ("krylov", "krylov"),
+        ("auto", "cholesky"),
+    ] {
+        let text = dense_scene(r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#)
+            .replace("count = 600", "count = 40")
+            .replace("mobility = \"free_draining\"", &format!("mobility = \"{method}\""))
+            .replace("duration = 1e-5", "duration = 3e-6");
+        let s = scene(&text);
+        let mut sim = Simulation::from_scene(&s, RunOptions::default()).unwrap();
+        let summary = sim.run(|_| {}).unwrap();
+        assert_eq!(summary["mobility"]["method"], expect, "{method}: {summary}");
+        assert!(summary["mobility"]["reason"].as_str().is_some_and(|r| !r.is_empty()));
+        let x = positions(&mut sim);
+        assert!(x.iter().all(|p| p.is_finite()));
+    }
+}
+
+#[test]
+fn shipped_brownian_scenes_run() {
+    for entry in std::fs::read_dir("scenes").unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !(name.starts_with("brownian_") && name.ends_with(".toml")) {
+            continue;
+        }
+        let mut s = magsep::scene::load_scene(&path, &Default::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        // a few steps of one replicate (the scenes' own durations are long)
+        let b = s.brownian.as_mut().unwrap();
+        b.duration = 3.0 * b.time_step;
+        b.runs = Some(1);
+        let summary = magsep::brownian::run_ensemble(&s, 1, &RunOptions::default(), &|_| {})
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(summary["steps"], 3, "{name}");
+    }
+}
