@@ -132,6 +132,15 @@ fn hi_reps(n: usize) -> usize {
     }
 }
 
+/// The 1-minute load average (Linux `/proc/loadavg`; NaN elsewhere): the machine is shared,
+/// so a rate is only as good as the load it was measured under.
+fn load_average() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(f64::NAN)
+}
+
 /// The scene name of a method (`free_draining`, `cholesky`, `tea`, `krylov`).
 pub fn method_name(m: MobilityMethod) -> &'static str {
     match m {
@@ -173,7 +182,8 @@ pub fn bench_brownian_with(
         let scene = crate::scene::parse_scene(&scene_text, &Default::default())
             .map_err(|e| BenchError::Runtime(format!("bench scene: {e}")))?;
         for &threads in &sizes.threads {
-            let (r, x) = pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
+            let (r, x) =
+                pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
             emit(
                 &mut rows,
                 as_json,
@@ -194,6 +204,7 @@ pub fn bench_brownian_with(
                     "substeps_per_step": r.substeps_per_step,
                     "force_evaluations_per_step": r.force_evaluations_per_step,
                     "lammps_reference_per_core": LAMMPS_REFERENCE_PER_CORE,
+                    "load_average_1min": load_average(),
                 }),
             );
             last_positions = x;

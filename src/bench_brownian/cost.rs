@@ -102,7 +102,10 @@ fn measure(
         }
     };
     let error = error_of(&mob).map_err(|e| {
-        BenchError::Runtime(format!("covariance error of {method:?} at N = {}: {e}", x.len()))
+        BenchError::Runtime(format!(
+            "covariance error of {method:?} at N = {}: {e}",
+            x.len()
+        ))
     })?;
     Ok((sum / reps as f64, error, mob.krylov_iterations()))
 }
@@ -131,7 +134,15 @@ pub fn cost_points(sizes: &CostChartSizes) -> Result<Vec<CostPoint>, BenchError>
             let exact = rpy_matrix(&x, &radii, VISCOSITY);
             let w = normal_vectors(n, 5);
             for &(method, tol) in &variants {
-                match measure(method, tol, &x, &radii, &w, &|m| covariance_error(m, &exact), sizes.min_time) {
+                match measure(
+                    method,
+                    tol,
+                    &x,
+                    &radii,
+                    &w,
+                    &|m| covariance_error(m, &exact),
+                    sizes.min_time,
+                ) {
                     Ok((cost_s, error, iterations)) => {
                         let p = CostPoint {
                             volume_fraction: phi,
@@ -183,8 +194,11 @@ fn panel(points: &[CostPoint], phi: f64, sizes: &[usize]) -> Chart {
         .join(", ");
     chart = chart
         .series(
-            Series::new(format!("free draining (no HI), N = {label}"), of("free_draining", None))
-                .style(Style::LineMarkers),
+            Series::new(
+                format!("free draining (no HI), N = {label}"),
+                of("free_draining", None),
+            )
+            .style(Style::LineMarkers),
         )
         .series(Series::new(format!("TEA, N = {label}"), of("tea", None)).style(Style::LineMarkers))
         .series(
@@ -196,8 +210,11 @@ fn panel(points: &[CostPoint], phi: f64, sizes: &[usize]) -> Chart {
         );
     for &n in sizes {
         chart = chart.series(
-            Series::new(format!("Krylov, tol 1e-2..1e-8, N = {n}"), of("krylov", Some(n)))
-                .style(Style::LineMarkers),
+            Series::new(
+                format!("Krylov, tol 1e-2..1e-8, N = {n}"),
+                of("krylov", Some(n)),
+            )
+            .style(Style::LineMarkers),
         );
     }
     chart

@@ -144,8 +144,9 @@ pub fn pipeline_rate(
 /// # Errors
 /// [`BenchError::Runtime`] when the scene cannot be built.
 pub fn initial_positions(n: usize, seed: u64) -> Result<Vec<DVec3>, BenchError> {
-    let scene = crate::scene::parse_scene(&free_draining_scene(n, false, seed), &Default::default())
-        .map_err(|e| BenchError::Runtime(format!("bench scene: {e}")))?;
+    let scene =
+        crate::scene::parse_scene(&free_draining_scene(n, false, seed), &Default::default())
+            .map_err(|e| BenchError::Runtime(format!("bench scene: {e}")))?;
     let sim = Simulation::from_scene(&scene, RunOptions::default())
         .map_err(|e| BenchError::Runtime(format!("bench simulation: {e}")))?;
     Ok(sim

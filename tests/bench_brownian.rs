@@ -1,0 +1,105 @@
+//! Smoke tests of `magsep bench brownian` and `magsep chart brownian-cost`: tiny sizes through
+//! the library API (rows well formed, rates positive, exponents finite; the chart writes a
+//! valid SVG and its JSON data).
+
+use magsep::bench_brownian::{
+    BrownianBenchSizes, CostChartSizes, bench_brownian_with, chart_brownian_cost_with,
+};
+use magsep::systems::brownian::hydro::MobilityMethod;
+
+fn positive(row: &serde_json::Value, key: &str) -> f64 {
+    let v = row[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing in {row}"));
+    assert!(v.is_finite() && v > 0.0, "{key} = {v} in {row}");
+    v
+}
+
+#[test]
+fn bench_rows_are_well_formed_with_positive_rates() {
+    let sizes = BrownianBenchSizes {
+        pipeline_n: 200,
+        warmup_steps: 1,
+        pipeline_seconds: 0.05,
+        threads: vec![1, 2],
+        hi_sizes: vec![20, 40],
+        hi_methods: vec![
+            MobilityMethod::Cholesky,
+            MobilityMethod::Tea,
+            MobilityMethod::Krylov,
+        ],
+    };
+    let rows = bench_brownian_with(&sizes, true).unwrap();
+    // every row survives a JSON round trip
+    for r in &rows {
+        let back: serde_json::Value = serde_json::from_str(&r.to_string()).unwrap();
+        assert_eq!(&back, r);
+        assert_eq!(r["bench"], "brownian");
+    }
+    let case =
+        |c: &str| -> Vec<&serde_json::Value> { rows.iter().filter(|r| r["case"] == c).collect() };
+    let pipe = case("free_draining_dipoles");
+    assert_eq!(pipe.len(), 4, "fixed and adaptive at 1 and 2 threads");
+    for r in &pipe {
+        positive(r, "particle_steps_per_s");
+        positive(r, "particle_steps_per_s_per_thread");
+        assert_eq!(r["n"], 200);
+        assert!(r["steps"].as_u64().unwrap() >= 3);
+        let sub = positive(r, "substeps_per_step");
+        if r["step_control"] == "fixed" {
+            assert_eq!(sub, 1.0);
+        } else {
+            assert!(sub >= 2.0);
+        }
+    }
+    let nb = case("dipole_neighbours");
+    assert_eq!(nb.len(), 1);
+    positive(nb[0], "mean_neighbours_start");
+    let hi = case("hi");
+    assert_eq!(hi.len(), 6);
+    for r in &hi {
+        positive(r, "s_per_step");
+        positive(r, "steps_per_s");
+    }
+    let ex = case("hi_exponent");
+    assert_eq!(ex.len(), 3);
+    for r in &ex {
+        assert!(r["exponent"].as_f64().unwrap().is_finite(), "{r}");
+    }
+}
+
+#[test]
+fn cost_chart_writes_svg_and_data() {
+    let dir = std::env::temp_dir().join(format!("magsep_bench_brownian_{}", std::process::id()));
+    let sizes = CostChartSizes {
+        sizes: vec![10, 20],
+        volume_fractions: vec![1e-2, 5e-2],
+        krylov_tolerances: vec![1e-2, 1e-6],
+        min_time: 0.0,
+    };
+    let summary = chart_brownian_cost_with(&dir, &sizes).unwrap();
+    let svg = std::fs::read_to_string(dir.join("brownian_mobility_cost.svg")).unwrap();
+    assert!(svg.trim_start().starts_with("<svg") || svg.trim_start().starts_with("<?xml"));
+    assert!(svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("Krylov"));
+    let data: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("brownian_mobility_cost.json")).unwrap(),
+    )
+    .unwrap();
+    let pts = data["points"].as_array().unwrap();
+    // 2 fractions x 2 sizes x (free draining, Cholesky, TEA, 2 Krylov tolerances)
+    assert_eq!(pts.len(), 20);
+    for p in pts {
+        assert!(p["cost_s"].as_f64().unwrap() > 0.0, "{p}");
+        let e = p["error"].as_f64().unwrap();
+        assert!(e.is_finite() && e >= 0.0, "{p}");
+        if p["method"] == "cholesky" {
+            assert!(e < 1e-10, "{p}");
+        }
+        if p["method"] == "free_draining" {
+            assert!(e > 1e-4, "{p}");
+        }
+    }
+    assert_eq!(summary["points"].as_array().unwrap().len(), 20);
+    std::fs::remove_dir_all(&dir).ok();
+}
