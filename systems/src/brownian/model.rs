@@ -66,6 +66,15 @@ impl ForceParts {
     }
 }
 
+/// The cell lists of one configuration.
+#[derive(Debug, Clone, Default)]
+pub struct PairCells {
+    /// Cells of the dipole cut-off (None: no dipole forces).
+    pub dipole: Option<CellList>,
+    /// Cells of the Mie range (None: no soft core).
+    pub contact: Option<CellList>,
+}
+
 /// Fibres, applied field and interaction parameters.
 #[derive(Debug, Clone)]
 pub struct ForceModel {
@@ -151,18 +160,18 @@ impl ForceModel {
         });
     }
 
-    /// Largest pair interaction range [m] for the cell list (0: no pair forces).
-    pub fn pair_range(&self, view: &ParticleView) -> f64 {
+    /// Cell lists of the particles that exert pair forces: one with the dipole cut-off of the
+    /// largest pair, one with the Mie range (so contacts do not scan the dipole neighbourhood).
+    pub fn cells(&self, x: &[DVec3], view: &ParticleView) -> PairCells {
         let amax = view.radii.iter().copied().fold(0.0, f64::max);
-        let dip = self.dipole_cutoff.map(|c| c * amax).unwrap_or(0.0);
-        let mie = self.mie.map(|m| 2.0 * amax * m.min_ratio).unwrap_or(0.0);
-        dip.max(mie)
-    }
-
-    /// Cell list of the particles that exert pair forces.
-    pub fn cells(&self, x: &[DVec3], view: &ParticleView) -> Option<CellList> {
-        let range = self.pair_range(view);
-        (range > 0.0).then(|| CellList::build(x, range, |j| view.exerts[j]))
+        let build = |range: f64, reach: i64| {
+            (range > 0.0 && range.is_finite())
+                .then(|| CellList::build_with_reach(x, range, reach, |j| view.exerts[j]))
+        };
+        PairCells {
+            dipole: self.dipole_cutoff.and_then(|c| build(c * amax, 2)),
+            contact: self.mie.and_then(|m| build(2.0 * amax * m.min_ratio, 1)),
+        }
     }
 
     /// Dipole-dipole forces on the mobile particles from the exerting ones [N].
@@ -171,10 +180,10 @@ impl ForceModel {
         x: &[DVec3],
         moments: &[DVec3],
         view: &ParticleView,
-        cells: Option<&CellList>,
+        cells: &PairCells,
         out: &mut [DVec3],
     ) {
-        let (Some(cut), Some(cells)) = (self.dipole_cutoff, cells) else {
+        let (Some(cut), Some(cells)) = (self.dipole_cutoff, cells.dipole.as_ref()) else {
             out.fill(DVec3::ZERO);
             return;
         };
@@ -200,10 +209,10 @@ impl ForceModel {
         &self,
         x: &[DVec3],
         view: &ParticleView,
-        cells: Option<&CellList>,
+        cells: &PairCells,
         out: &mut [DVec3],
     ) {
-        let (Some(mie), Some(cells)) = (self.mie, cells) else {
+        let (Some(mie), Some(cells)) = (self.mie, cells.contact.as_ref()) else {
             out.fill(DVec3::ZERO);
             return;
         };
@@ -254,9 +263,9 @@ impl ForceModel {
         }
         let cells = self.cells(x, view);
         let moments = std::mem::take(&mut parts.moments);
-        self.dipole_forces(x, &moments, view, cells.as_ref(), &mut parts.dipole);
+        self.dipole_forces(x, &moments, view, &cells, &mut parts.dipole);
         parts.moments = moments;
-        self.contact_forces(x, view, cells.as_ref(), &mut parts.contact);
+        self.contact_forces(x, view, &cells, &mut parts.contact);
     }
 }
 

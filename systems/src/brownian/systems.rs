@@ -18,10 +18,9 @@ use glam::DVec3;
 use magsep_components::prelude::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-use super::cells::CellList;
 use super::dynamics::{HydroState, PipelineDynamics};
 use super::hydro::{Mobility, MobilityMethod, auto_method};
-use super::model::{ForceModel, ParticleView};
+use super::model::{ForceModel, PairCells, ParticleView};
 use super::pair::Mie;
 use super::stepper::advance;
 use crate::field::CylinderSource;
@@ -46,8 +45,8 @@ pub struct BrownianWorkspace {
     pub model: ForceModel,
     /// Moments at the step start [A m²].
     pub moments: Vec<DVec3>,
-    /// Cell list at the step start.
-    pub cells: Option<CellList>,
+    /// Cell lists at the step start.
+    pub cells: PairCells,
     /// Mobility of this step (None: free draining).
     pub hydro: Option<HydroState>,
     /// Resolved mobility method.
@@ -178,7 +177,7 @@ pub fn init_brownian_workspace(world: &mut World) {
         positions,
         radii,
         model: force_model(&config, &fibres, &field),
-        cells: None,
+        cells: PairCells::default(),
         hydro: None,
         method,
     });
@@ -258,7 +257,7 @@ pub fn compute_dipole_forces(
     };
     let mut f = vec![DVec3::ZERO; ws.positions.len()];
     ws.model
-        .dipole_forces(&ws.positions, &ws.moments, &view, ws.cells.as_ref(), &mut f);
+        .dipole_forces(&ws.positions, &ws.moments, &view, &ws.cells, &mut f);
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
 
@@ -277,7 +276,7 @@ pub fn compute_contact_forces(
     };
     let mut f = vec![DVec3::ZERO; ws.positions.len()];
     ws.model
-        .contact_forces(&ws.positions, &view, ws.cells.as_ref(), &mut f);
+        .contact_forces(&ws.positions, &view, &ws.cells, &mut f);
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
 
