@@ -150,7 +150,7 @@ pub enum StepControl {
     /// two-half-step results agree within `tolerance` and no particle moves more than
     /// `max_displacement` (both in units of its radius).
     Adaptive {
-        /// Local error tolerance in units of the particle radius. Default 1e-3. Range (0, 1].
+        /// Local error tolerance in units of the particle radius. Default 1e-2. Range (0, 1].
         tolerance: f64,
         /// Largest move of one accepted sub-step in units of the radius. Default 0.2.
         /// Range (0, 10].
@@ -163,7 +163,7 @@ pub enum StepControl {
 impl Default for StepControl {
     fn default() -> Self {
         Self::Adaptive {
-            tolerance: 1e-3,
+            tolerance: 1e-2,
             max_displacement: 0.2,
             max_depth: 24,
         }
