@@ -134,8 +134,7 @@ pub fn record_frame(
     container: Res<Container>,
     status: Option<Res<PackingStatus>>,
     ws: Option<Res<McmWorkspace>>,
-    brownian: Option<Res<BrownianConfig>>,
-    stats: Option<Res<BrownianStats>>,
+    (brownian, stats): (Option<Res<BrownianConfig>>, Option<Res<BrownianStats>>),
     q: FrameQuery,
 ) {
     if rec.writer.is_none() || rec.last_step == Some(clock.step) {

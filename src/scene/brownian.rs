@@ -136,7 +136,7 @@ impl BrownianSection {
             step_control: self.step_control.unwrap_or_default(),
             contact: self.contact.unwrap_or_default(),
             dipole_cutoff: match self.dipole_cutoff {
-                Some(c) if c == 0.0 => None,
+                Some(0.0) => None,
                 Some(c) => Some(c),
                 None => Some(30.0),
             },

@@ -256,7 +256,7 @@ mod tests {
             let cells = CellList::build_with_reach(p, cutoff * 1.3, reach, skip);
             for i in 0..p.len() {
                 let mut got = vec![];
-                cells.for_each_neighbour(&p, i, cutoff, |j, d| {
+                cells.for_each_neighbour(p, i, cutoff, |j, d| {
                     assert_eq!(d, p[i] - p[j]);
                     got.push(j)
                 });
