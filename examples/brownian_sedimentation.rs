@@ -49,14 +49,7 @@ pub struct SedimentationPlugin {
 impl SimPlugin for SedimentationPlugin {
     fn build(&self, app: &mut SimApp) {
         app.world.insert_resource(DensityExcess(self.excess));
-        let ids: Vec<Entity> = app
-            .world
-            .query_filtered::<Entity, With<ParticleId>>()
-            .iter(&app.world)
-            .collect();
-        for e in ids {
-            app.world.entity_mut(e).insert(SedimentationForce::default());
-        }
+        app.insert_on_particles(SedimentationForce::default());
         app.register_force::<SedimentationForce>();
         app.schedule
             .add_systems(compute_sedimentation.in_set(ForceSystems::Custom));

@@ -48,14 +48,7 @@ pub struct TrapPlugin {
 impl SimPlugin for TrapPlugin {
     fn build(&self, app: &mut SimApp) {
         app.world.insert_resource(TrapStiffness(self.stiffness));
-        let ids: Vec<Entity> = app
-            .world
-            .query_filtered::<Entity, With<ParticleId>>()
-            .iter(&app.world)
-            .collect();
-        for e in ids {
-            app.world.entity_mut(e).insert(TrapForce::default());
-        }
+        app.insert_on_particles(TrapForce::default());
         app.register_force::<TrapForce>();
         app.schedule
             .add_systems(compute_trap_force.in_set(ForceSystems::Custom));

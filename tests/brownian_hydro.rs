@@ -8,6 +8,9 @@ use magsep::plugins::brownian::brownian_pipeline;
 use magsep::prelude::*;
 use magsep::scene::parse_scene;
 
+mod common;
+use common::sorted_positions;
+
 #[derive(Component, Debug, Default, Clone, Copy)]
 struct PushForce(DVec3);
 
@@ -33,14 +36,7 @@ struct PushPlugin;
 
 impl SimPlugin for PushPlugin {
     fn build(&self, app: &mut SimApp) {
-        let ids: Vec<Entity> = app
-            .world
-            .query_filtered::<Entity, With<ParticleId>>()
-            .iter(&app.world)
-            .collect();
-        for e in ids {
-            app.world.entity_mut(e).insert(PushForce::default());
-        }
+        app.insert_on_particles(PushForce::default());
         app.register_force::<PushForce>();
         app.schedule.add_systems(push.in_set(ForceSystems::Custom));
     }
@@ -83,18 +79,6 @@ placement = {{ kind = "points", positions = [[0.0, 0.0, 0.0], [{}, {}, {}]] }}
     [(x1[0] - x0[0]) / dt, (x1[1] - x0[1]) / dt]
 }
 
-fn sorted_positions(sim: &mut Simulation) -> Vec<DVec3> {
-    let mut v: Vec<(ParticleId, DVec3)> = sim
-        .app
-        .world
-        .query::<(&ParticleId, &Position)>()
-        .iter(&sim.app.world)
-        .map(|(i, p)| (*i, p.0))
-        .collect();
-    v.sort_by_key(|r| r.0);
-    v.into_iter().map(|r| r.1).collect()
-}
-
 #[test]
 fn two_spheres_settle_with_the_rpy_closed_forms() {
     let (a, eta) = (100e-9, 1e-3);
@@ -108,13 +92,19 @@ fn two_spheres_settle_with_the_rpy_closed_forms() {
             // line of centres along the force
             let v = velocities(method, a, DVec3::new(0.0, 0.0, r));
             for vi in v {
-                assert!((vi.z + parallel).abs() < 1e-6 * parallel, "{method} {r_over_a}: {vi}");
+                assert!(
+                    (vi.z + parallel).abs() < 1e-6 * parallel,
+                    "{method} {r_over_a}: {vi}"
+                );
                 assert!(vi.x.abs() + vi.y.abs() < 1e-6 * parallel);
             }
             // line of centres across the force
             let v = velocities(method, a, DVec3::new(r, 0.0, 0.0));
             for vi in v {
-                assert!((vi.z + perpendicular).abs() < 1e-6 * perpendicular, "{method}: {vi}");
+                assert!(
+                    (vi.z + perpendicular).abs() < 1e-6 * perpendicular,
+                    "{method}: {vi}"
+                );
             }
         }
         // no hydrodynamic interactions: Stokes' law for each

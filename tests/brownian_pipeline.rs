@@ -1,24 +1,14 @@
 //! App-level tests of the brownian pipeline: free diffusion, determinism across thread counts,
 //! the stability of the fixed and adaptive steps on one scene, capture, record/replay/resume.
 
-use glam::DVec3;
 use magsep::prelude::*;
 use magsep::scene::{Scene, parse_scene};
 
+mod common;
+use common::sorted_positions as positions;
+
 fn scene(text: &str) -> Scene {
     parse_scene(text, &Default::default()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn positions(sim: &mut Simulation) -> Vec<DVec3> {
-    let mut rows: Vec<(ParticleId, DVec3)> = sim
-        .app
-        .world
-        .query::<(&ParticleId, &Position)>()
-        .iter(&sim.app.world)
-        .map(|(i, p)| (*i, p.0))
-        .collect();
-    rows.sort_by_key(|r| r.0);
-    rows.into_iter().map(|r| r.1).collect()
 }
 
 fn free_scene(n: u64, dt: f64, steps: u64, extra: &str) -> String {
@@ -52,7 +42,11 @@ fn free_particles_diffuse_with_msd_6dt() {
     let x0 = positions(&mut sim);
     sim.run(|_| {}).unwrap();
     let x1 = positions(&mut sim);
-    let msd = x0.iter().zip(&x1).map(|(a, b)| (*a - *b).length_squared()).sum::<f64>()
+    let msd = x0
+        .iter()
+        .zip(&x1)
+        .map(|(a, b)| (*a - *b).length_squared())
+        .sum::<f64>()
         / x0.len() as f64;
     let d = 1.380649e-23 * 298.0 / (6.0 * std::f64::consts::PI * 1e-3 * 100e-9);
     let ratio = msd / (6.0 * d * dt * steps as f64);
@@ -114,7 +108,8 @@ fn dipole_pair_fixed_step_fails_at_thesis_dt_adaptive_does_not() {
         "fixed step at 5e-5 s should fail (deep overlap or a torn pair): {lo}..{hi} radii"
     );
     // the same scene with error control: the pair stays in contact, never overlapping
-    let adaptive = r#"{ kind = "adaptive", tolerance = 1e-2, max_displacement = 0.2, max_depth = 30 }"#;
+    let adaptive =
+        r#"{ kind = "adaptive", tolerance = 1e-2, max_displacement = 0.2, max_depth = 30 }"#;
     let (lo, hi) = separation_range(&pair_scene(5e-5, 100, adaptive));
     assert!(lo > 1.98 && hi < 2.4, "adaptive: {lo}..{hi} radii");
     // where the fixed step becomes stable: D dt U''/kT = 0.71 at dt = 1e-7 s
@@ -147,9 +142,14 @@ placement = {{ kind = "box", min = [0.0, 0.0, 0.0], max = [6e-6, 6e-6, 6e-6] }}
 
 #[test]
 fn bitwise_identical_for_one_and_two_threads() {
-    let s = scene(&dense_scene(r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#));
+    let s = scene(&dense_scene(
+        r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#,
+    ));
     let run = |threads: usize, single: bool| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut sim = Simulation::from_scene(
                 &s,
@@ -165,7 +165,11 @@ fn bitwise_identical_for_one_and_two_threads() {
     };
     let a = run(1, true);
     let b = run(2, false);
-    assert!(a.iter().zip(&b).all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits)));
+    assert!(
+        a.iter()
+            .zip(&b)
+            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
+    );
 }
 
 #[test]
@@ -176,15 +180,24 @@ fn every_mobility_runs_in_the_pipeline_and_is_reported() {
         ("krylov", "krylov"),
         ("auto", "cholesky"),
     ] {
-        let text = dense_scene(r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#)
-            .replace("count = 600", "count = 40")
-            .replace("mobility = \"free_draining\"", &format!("mobility = \"{method}\""))
-            .replace("duration = 1e-5", "duration = 3e-6");
+        let text = dense_scene(
+            r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#,
+        )
+        .replace("count = 600", "count = 40")
+        .replace(
+            "mobility = \"free_draining\"",
+            &format!("mobility = \"{method}\""),
+        )
+        .replace("duration = 1e-5", "duration = 3e-6");
         let s = scene(&text);
         let mut sim = Simulation::from_scene(&s, RunOptions::default()).unwrap();
         let summary = sim.run(|_| {}).unwrap();
         assert_eq!(summary["mobility"]["method"], expect, "{method}: {summary}");
-        assert!(summary["mobility"]["reason"].as_str().is_some_and(|r| !r.is_empty()));
+        assert!(
+            summary["mobility"]["reason"]
+                .as_str()
+                .is_some_and(|r| !r.is_empty())
+        );
         let x = positions(&mut sim);
         assert!(x.iter().all(|p| p.is_finite()));
     }

@@ -126,6 +126,20 @@ impl SimApp {
         self
     }
 
+    /// Insert a clone of `component` on every particle entity (those with a `ParticleId`), e.g.
+    /// a plugin's own force contribution.
+    pub fn insert_on_particles<C: Component + Clone>(&mut self, component: C) -> &mut Self {
+        let ids: Vec<Entity> = self
+            .world
+            .query_filtered::<Entity, With<magsep_components::particle::ParticleId>>()
+            .iter(&self.world)
+            .collect();
+        for e in ids {
+            self.world.entity_mut(e).insert(component.clone());
+        }
+        self
+    }
+
     /// Names of the plugins built, in order.
     pub fn plugin_names(&self) -> &[String] {
         &self.plugin_names

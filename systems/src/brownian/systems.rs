@@ -242,13 +242,13 @@ pub fn compute_field_forces(
     write_dense(&ws, &ws.moments, &mut moments, |c, v| c.0 = v);
 }
 
-/// Dipole-dipole forces.
-pub fn compute_dipole_forces(
-    ws: Res<BrownianWorkspace>,
-    config: Res<BrownianConfig>,
-    mut forces: Query<&mut DipoleForce>,
-) {
-    let (mobile, exerts) = (ws.mobile(), ws.exerts(&config));
+/// Evaluate one pair-force kernel over the workspace into `out` (a dense array).
+fn pair_forces(
+    ws: &BrownianWorkspace,
+    config: &BrownianConfig,
+    kernel: impl Fn(&ParticleView, &mut [DVec3]),
+) -> Vec<DVec3> {
+    let (mobile, exerts) = (ws.mobile(), ws.exerts(config));
     let view = ParticleView {
         radii: &ws.radii,
         moments: &ws.laws,
@@ -256,8 +256,20 @@ pub fn compute_dipole_forces(
         exerts: &exerts,
     };
     let mut f = vec![DVec3::ZERO; ws.positions.len()];
-    ws.model
-        .dipole_forces(&ws.positions, &ws.moments, &view, &ws.cells, &mut f);
+    kernel(&view, &mut f);
+    f
+}
+
+/// Dipole-dipole forces.
+pub fn compute_dipole_forces(
+    ws: Res<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    mut forces: Query<&mut DipoleForce>,
+) {
+    let f = pair_forces(&ws, &config, |view, out| {
+        ws.model
+            .dipole_forces(&ws.positions, &ws.moments, view, &ws.cells, out)
+    });
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
 
@@ -267,16 +279,9 @@ pub fn compute_contact_forces(
     config: Res<BrownianConfig>,
     mut forces: Query<&mut ContactForce>,
 ) {
-    let (mobile, exerts) = (ws.mobile(), ws.exerts(&config));
-    let view = ParticleView {
-        radii: &ws.radii,
-        moments: &ws.laws,
-        mobile: &mobile,
-        exerts: &exerts,
-    };
-    let mut f = vec![DVec3::ZERO; ws.positions.len()];
-    ws.model
-        .contact_forces(&ws.positions, &view, &ws.cells, &mut f);
+    let f = pair_forces(&ws, &config, |view, out| {
+        ws.model.contact_forces(&ws.positions, view, &ws.cells, out)
+    });
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
 
