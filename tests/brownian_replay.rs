@@ -55,12 +55,21 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
     .unwrap();
     let summary = sim.run(|_| {}).unwrap();
     let captured = summary["captured_fraction"]["mean"].as_f64().unwrap();
-    assert!(captured > 0.0 && captured < 1.0, "want a partly captured run, got {captured}");
+    assert!(
+        captured > 0.0 && captured < 1.0,
+        "want a partly captured run, got {captured}"
+    );
 
     // replay: the same curve and fractions
     let rec = read_recording(&full).unwrap();
     let (replayed, _) = magsep::replay::replay(&full).unwrap();
-    for key in ["capture_curve", "captured_fraction", "brownian_fraction", "groups", "steps"] {
+    for key in [
+        "capture_curve",
+        "captured_fraction",
+        "brownian_fraction",
+        "groups",
+        "steps",
+    ] {
         assert_eq!(replayed[key], summary[key], "{key}");
     }
     // captured particles are coloured in the viewer channel: the status says who
@@ -74,16 +83,30 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
     let partial = read_recording(&cut).unwrap();
     assert!(partial.truncated.is_some());
     let k = partial.frames.len();
-    assert!(k >= 2 && k < rec.frames.len(), "{k} of {}", rec.frames.len());
+    assert!(
+        k >= 2 && k < rec.frames.len(),
+        "{k} of {}",
+        rec.frames.len()
+    );
     let resumed_path = dir.join("resumed.mcap");
     let resumed = resume(&cut, Some(resumed_path.clone()), |_| {}).unwrap();
-    for key in ["capture_curve", "captured_fraction", "brownian_fraction", "steps", "stepper"] {
+    for key in [
+        "capture_curve",
+        "captured_fraction",
+        "brownian_fraction",
+        "steps",
+        "stepper",
+    ] {
         assert_eq!(resumed[key], summary[key], "{key}");
     }
     let again = read_recording(&resumed_path).unwrap();
     let (a, b) = (rec.frames.last().unwrap(), again.frames.last().unwrap());
     assert_eq!(a.step, b.step);
-    assert_eq!(bits(a), bits(b), "resumed run differs from the uninterrupted one");
+    assert_eq!(
+        bits(a),
+        bits(b),
+        "resumed run differs from the uninterrupted one"
+    );
     assert_eq!(a.status_json, b.status_json);
     std::fs::remove_dir_all(&dir).ok();
 }

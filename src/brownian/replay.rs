@@ -50,7 +50,11 @@ fn status(frame: &ParticleFrame) -> Result<FrameStatus, ReplayError> {
 ///
 /// # Errors
 /// [`ReplayError::BadFrame`] for a frame without brownian state or of the wrong size.
-pub fn frame_result(scene: &Scene, frame: &ParticleFrame, seed: u64) -> Result<RunResult, ReplayError> {
+pub fn frame_result(
+    scene: &Scene,
+    frame: &ParticleFrame,
+    seed: u64,
+) -> Result<RunResult, ReplayError> {
     let st = status(frame)?;
     let b = st.brownian.unwrap_or_default();
     let section = scene
@@ -66,21 +70,30 @@ pub fn frame_result(scene: &Scene, frame: &ParticleFrame, seed: u64) -> Result<R
     if species.len() != frame.ids.len() {
         return Err(bad(
             frame,
-            format!("{} particles, the scene has {}", frame.ids.len(), species.len()),
+            format!(
+                "{} particles, the scene has {}",
+                frame.ids.len(),
+                species.len()
+            ),
         ));
     }
     let t = frame.time;
     let brownian = (0..frame.ids.len())
         .map(|i| {
             let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * frame.radii[i]);
-            let d2 = (frame.positions[i] - DVec3::from_array(b.initial_positions[i])).length_squared();
+            let d2 =
+                (frame.positions[i] - DVec3::from_array(b.initial_positions[i])).length_squared();
             b.captured[i].is_none() && d2 < 2.0 * 6.0 * d * t
         })
         .collect();
     Ok(RunResult {
         seed,
         steps: frame.step,
-        dt: if frame.step > 0 { frame.time / frame.step as f64 } else { section.time_step },
+        dt: if frame.step > 0 {
+            frame.time / frame.step as f64
+        } else {
+            section.time_step
+        },
         species,
         capture_steps: b.captured.iter().map(|c| c.map(|c| c.step)).collect(),
         brownian,
@@ -105,12 +118,18 @@ pub fn start_regions(scene: &Scene) -> StartRegions {
 /// [`ReplayError`] when the recording has no frame or its state is malformed.
 pub fn replay_brownian(rec: &Recording, scene: &Scene, seed: u64) -> Result<Value, ReplayError> {
     let frame = rec.frames.last().ok_or_else(|| {
-        ReplayError::NoFrames(rec.truncated.clone().map(|t| format!(" ({t})")).unwrap_or_default())
+        ReplayError::NoFrames(
+            rec.truncated
+                .clone()
+                .map(|t| format!(" ({t})"))
+                .unwrap_or_default(),
+        )
     })?;
     let result = frame_result(scene, frame, seed)?;
-    let config = scene.brownian_section().map(|s| s.config()).unwrap_or_else(|| {
-        unreachable!("frame_result checked the scene is brownian")
-    });
+    let config = scene
+        .brownian_section()
+        .map(|s| s.config())
+        .unwrap_or_else(|| unreachable!("frame_result checked the scene is brownian"));
     let wall = rec
         .summary_json
         .as_deref()
@@ -144,10 +163,16 @@ pub fn apply_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Repla
     let mut count = 0;
     for (id, mut p, mut r, mut c, mut x0, shape) in q.iter_mut(world) {
         let Some(k) = frame.ids.iter().position(|i| *i == id.0) else {
-            return Err(bad(frame, format!("particle {} of the scene is not in the frame", id.0)));
+            return Err(bad(
+                frame,
+                format!("particle {} of the scene is not in the frame", id.0),
+            ));
         };
         if frame.radii[k] != shape.radius() {
-            return Err(bad(frame, format!("particle {}: radius differs from the scene", id.0)));
+            return Err(bad(
+                frame,
+                format!("particle {}: radius differs from the scene", id.0),
+            ));
         }
         p.0 = frame.positions[k];
         r.0 = rng_from_state_words(frame.rng_states[k]);
@@ -200,7 +225,12 @@ pub fn resume(
         .into());
     }
     let frame = rec.frames.last().cloned().ok_or_else(|| {
-        ReplayError::NoFrames(rec.truncated.clone().map(|t| format!(" ({t})")).unwrap_or_default())
+        ReplayError::NoFrames(
+            rec.truncated
+                .clone()
+                .map(|t| format!(" ({t})"))
+                .unwrap_or_default(),
+        )
     })?;
     let options = RunOptions {
         seed: Some(meta.seed),

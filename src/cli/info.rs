@@ -120,7 +120,11 @@ pub fn replay(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
-pub fn resume(path: &Path, record: Option<std::path::PathBuf>, quiet: bool) -> Result<(), CliError> {
+pub fn resume(
+    path: &Path,
+    record: Option<std::path::PathBuf>,
+    quiet: bool,
+) -> Result<(), CliError> {
     let bar = if quiet {
         indicatif::ProgressBar::hidden()
     } else {

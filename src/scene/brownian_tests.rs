@@ -46,10 +46,20 @@ fn good_scene_parses_with_defaults_and_region_volumes() {
     assert_eq!(c.dipole_cutoff, Some(30.0));
     assert_eq!(c.observe_every, 100);
     assert_eq!(b.runs(), 3);
-    let top = s.particles[0].placement.as_ref().unwrap().volume(&s.fibres).unwrap();
+    let top = s.particles[0]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
     let pi = std::f64::consts::PI;
     assert!((top - pi * 300e-6f64.powi(2) * 300e-6).abs() < 1e-20);
-    let side = s.particles[1].placement.as_ref().unwrap().volume(&s.fibres).unwrap();
+    let side = s.particles[1]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
     let (r0, r1) = (301e-6f64, 601e-6f64);
     assert!((side - pi * (r1 * r1 - r0 * r0) * 12e-3).abs() < 1e-18);
 }
@@ -59,7 +69,10 @@ fn every_problem_is_reported_with_its_key_path() {
     let bad = GOOD
         .replace("time_step = 5e-5", "time_step = -1.0")
         .replace("runs = 3", "runs = 0")
-        .replace("fibre = 0, gap = 1e-6, height", "fibre = 4, gap = 1e-9, height")
+        .replace(
+            "fibre = 0, gap = 1e-6, height",
+            "fibre = 4, gap = 1e-9, height",
+        )
         .replace("moment = 0.87e-16 }", "moment = -1.0 }")
         .replace("domain_moment = 2.3e-19", "domain_moment = 0.0");
     let p = paths(&bad);
@@ -78,9 +91,15 @@ fn every_problem_is_reported_with_its_key_path() {
 #[test]
 fn pipeline_specific_keys_are_checked() {
     // container is not allowed (unbounded fluid); [brownian] is required
-    let p = paths(&GOOD.replace("[brownian]", "[container]\nkind = \"periodic_box\"\n[brownian]"));
+    let p = paths(&GOOD.replace(
+        "[brownian]",
+        "[container]\nkind = \"periodic_box\"\n[brownian]",
+    ));
     assert!(p.contains(&"container".to_string()), "{p:?}");
-    let p = paths(&GOOD.replace("[brownian]\ntime_step = 5e-5\nduration = 1.0\nruns = 3\n", ""));
+    let p = paths(&GOOD.replace(
+        "[brownian]\ntime_step = 5e-5\nduration = 1.0\nruns = 3\n",
+        "",
+    ));
     assert!(p.contains(&"brownian".to_string()), "{p:?}");
     // placement is required, spheres only
     let p = paths(&GOOD.replace(
@@ -96,13 +115,19 @@ fn pipeline_specific_keys_are_checked() {
     assert!(p.contains(&"particles[0].shape.kind".to_string()), "{p:?}");
     // typos in nested tables name the key
     let p = paths(&GOOD.replace("runs = 3", "runs = 3\nstep_control = { kind = \"adaptive\", tolerance = 1e-3, max_displacement = 0.2, max_depht = 3 }"));
-    assert!(p.iter().any(|x| x.starts_with("brownian.step_control")), "{p:?}");
+    assert!(
+        p.iter().any(|x| x.starts_with("brownian.step_control")),
+        "{p:?}"
+    );
     // points must match the count
     let p = paths(&GOOD.replace(
         "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
         "placement = { kind = \"points\", positions = [[0.0, 0.0, 1.0]] }",
     ));
-    assert!(p.contains(&"particles[0].placement.positions".to_string()), "{p:?}");
+    assert!(
+        p.contains(&"particles[0].placement.positions".to_string()),
+        "{p:?}"
+    );
     // moment and placement belong to the brownian pipeline only
     let packing = "[simulation]\npipeline = \"packing\"\n[container]\nkind = \"periodic_box\"\n[[particles]]\ncount = 3\nshape = { kind = \"sphere\", radius = 1.0 }\nmoment = { kind = \"saturated\", moment = 1.0 }\n";
     assert!(paths(packing).contains(&"particles[0].moment".to_string()));

@@ -17,12 +17,12 @@
 //! ```
 
 mod brownian;
+#[cfg(test)]
+mod brownian_tests;
 mod fibres;
 mod placement;
 mod sections;
 mod spawn;
-#[cfg(test)]
-mod brownian_tests;
 #[cfg(test)]
 mod tests;
 mod validate;
