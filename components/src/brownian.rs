@@ -152,7 +152,7 @@ pub enum StepControl {
     Adaptive {
         /// Local error tolerance in units of the particle radius. Default 1e-2. Range (0, 1].
         tolerance: f64,
-        /// Largest move of one accepted sub-step in units of the radius. Default 0.2.
+        /// Largest move of one accepted sub-step in units of the radius. Default 0.5.
         /// Range (0, 10].
         max_displacement: f64,
         /// Deepest bisection (sub-steps of dt / 2^depth). Default 24. Range 1..=40.
@@ -164,7 +164,7 @@ impl Default for StepControl {
     fn default() -> Self {
         Self::Adaptive {
             tolerance: 1e-2,
-            max_displacement: 0.2,
+            max_displacement: 0.5,
             max_depth: 24,
         }
     }

@@ -5,6 +5,7 @@ pub mod ensemble;
 pub mod replay;
 pub mod stats;
 pub mod summary;
+pub mod sweep;
 
 pub use ensemble::run_ensemble;
 pub use summary::{RunResult, StartRegions, run_result, run_summary, summary_of};

@@ -89,7 +89,13 @@ fn fraction(results: &[RunResult], f: impl Fn(&RunResult) -> (u64, u64)) -> Esti
             k as f64 / n.max(1) as f64
         })
         .collect();
-    mean_interval(&v)
+    // a fraction's interval stays in [0, 1] (few runs give wide t intervals)
+    let e = mean_interval(&v);
+    Estimate {
+        lo: e.lo.max(0.0),
+        hi: e.hi.min(1.0),
+        ..e
+    }
 }
 
 /// Captured count among particles of `group` (all when `None`) by step `s`.

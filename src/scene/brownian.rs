@@ -13,7 +13,7 @@
 //! temperature = 298.0       # [K]
 //! viscosity = 1.0e-3        # [Pa s]
 //! mobility = "auto"         # free_draining | cholesky | tea | krylov | auto
-//! step_control = { kind = "adaptive", tolerance = 1e-2, max_displacement = 0.2, max_depth = 24 }
+//! step_control = { kind = "adaptive", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }
 //! contact = { kind = "mie", epsilon_kt = 100.0, n = 30.0, m = 15.0 }   # or hard_core, none
 //! dipole_cutoff = 30.0      # in mean radii of the pair; 0 switches dipole forces off
 //! captured_interact = true  # captured particles keep exerting dipole/contact forces
@@ -65,7 +65,7 @@ pub struct BrownianSection {
     /// Krylov tolerance. Default 1e-6. Range (0, 0.1].
     #[serde(default)]
     pub krylov_tolerance: Option<f64>,
-    /// Time stepping. Default adaptive (tolerance 1e-2, max_displacement 0.2, max_depth 24).
+    /// Time stepping. Default adaptive (tolerance 1e-2, max_displacement 0.5, max_depth 24).
     #[serde(default)]
     pub step_control: Option<StepControl>,
     /// Excluded volume. Default Mie(30, 15) with ε = 100 k_B T.
