@@ -98,6 +98,30 @@ pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Replay
     Ok(())
 }
 
+/// The last complete frame of `rec`, or why there is none.
+///
+/// # Errors
+/// [`ReplayError::NoFrames`], with the truncation found.
+pub fn last_frame(rec: &Recording) -> Result<&ParticleFrame, ReplayError> {
+    rec.frames.last().ok_or_else(|| {
+        ReplayError::NoFrames(
+            rec.truncated
+                .clone()
+                .map(|t| format!(" ({t})"))
+                .unwrap_or_default(),
+        )
+    })
+}
+
+/// The run's wall time [s] from the recorded summary (0 when absent).
+pub fn recorded_wall_time(rec: &Recording) -> f64 {
+    rec.summary_json
+        .as_deref()
+        .and_then(|s| serde_json::from_str::<Value>(s).ok())
+        .and_then(|v| v.get("wall_time_s").and_then(Value::as_f64))
+        .unwrap_or(0.0)
+}
+
 /// Replay a recording: the summary of its last frame (same keys as `magsep run`), and the
 /// recording itself.
 ///
@@ -111,14 +135,7 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
         let summary = crate::brownian::replay::replay_brownian(&rec, &scene, meta.seed)?;
         return Ok((summary, rec));
     }
-    let frame = rec.frames.last().ok_or_else(|| {
-        ReplayError::NoFrames(
-            rec.truncated
-                .clone()
-                .map(|t| format!(" ({t})"))
-                .unwrap_or_default(),
-        )
-    })?;
+    let frame = last_frame(&rec)?;
     let mut app = SimApp::new();
     app.world.insert_resource(scene.packing_config());
     load_frame(&mut app.world, frame)?;
@@ -128,12 +145,7 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
         detail: e.0,
     })?;
     app.observe_now();
-    let wall = rec
-        .summary_json
-        .as_deref()
-        .and_then(|s| serde_json::from_str::<Value>(s).ok())
-        .and_then(|v| v.get("wall_time_s").and_then(Value::as_f64))
-        .unwrap_or(0.0);
+    let wall = recorded_wall_time(&rec);
     let mut summary = packing_summary(&app.world, meta.seed, wall);
     if let Some(t) = &rec.truncated {
         summary["truncated"] = Value::String(t.clone());

@@ -103,3 +103,22 @@ fn cost_chart_writes_svg_and_data() {
     assert_eq!(summary["points"].as_array().unwrap().len(), 20);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn chart_brownian_quick_writes_every_figure() {
+    let dir = std::env::temp_dir().join(format!("magsep-chart-brownian-{}", std::process::id()));
+    magsep::brownian::chart::chart_brownian(&dir, true).unwrap();
+    for name in [
+        "brownian_angle_curves.svg",
+        "brownian_final_vs_angle.svg",
+        "brownian_aspect.svg",
+        "brownian_concentrated.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{name}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -222,3 +222,39 @@ fn shipped_brownian_scenes_run() {
         assert_eq!(summary["steps"], 3, "{name}");
     }
 }
+
+#[test]
+fn hard_cores_never_overlap_in_a_dipolar_cloud() {
+    // the dipolar cloud of 600 particles with the thesis's explicit 5e-5 s step: close pairs
+    // jump radii per step into each other, and the hard cores must push them back to contact
+    let text = dense_scene(r#"{ kind = "fixed" }"#)
+        .replace(
+            "mobility = \"free_draining\"",
+            "mobility = \"free_draining\"\ncontact = { kind = \"hard_core\" }",
+        )
+        .replace("time_step = 1e-6", "time_step = 5e-5")
+        .replace("duration = 1e-5", "duration = 5e-4");
+    let s = scene(&text);
+    let mut sim = Simulation::from_scene(&s, RunOptions::default()).unwrap();
+    let a = 75e-9;
+    let mut closest = f64::INFINITY;
+    while !sim.is_finished() {
+        sim.step();
+        let x = positions(&mut sim);
+        for i in 0..x.len() {
+            for j in i + 1..x.len() {
+                closest = closest.min((x[i] - x[j]).length());
+            }
+        }
+    }
+    assert!(
+        closest >= 2.0 * a * (1.0 - 1e-9),
+        "closest pair {} radii",
+        closest / a
+    );
+    assert!(
+        closest < 2.2 * a,
+        "no contact formed: {} radii",
+        closest / a
+    );
+}

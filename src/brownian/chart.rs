@@ -44,91 +44,34 @@ struct Plan {
 }
 
 fn plan(quick: bool) -> Plan {
-    let adaptive = Some((1e-2, 5.0));
     if quick {
         return Plan {
             angles: vec![0.0, 45.0, 90.0],
             radii: vec![75e-9, 212e-9],
-            dilute: Reduction {
-                time_step: Some(1e-3),
-                duration: Some(1.0),
-                runs: Some(2),
-                count: Some(20),
-                mobility: Some("free_draining".into()),
-                adaptive,
-                observe_every: Some(10),
-            },
+            dilute: Reduction::free_draining(1e-3, 1.0, 2, 20, 10),
             small: None,
             aspect_angles: vec![0.0, 90.0],
-            aspect: Reduction {
-                time_step: Some(1e-3),
-                duration: Some(1.0),
-                runs: Some(2),
-                count: Some(20),
-                mobility: Some("free_draining".into()),
-                adaptive,
-                observe_every: Some(10),
-            },
-            concentrated: Reduction {
-                time_step: Some(2e-4),
-                duration: Some(1.0),
-                runs: Some(1),
-                count: Some(50),
-                mobility: Some("free_draining".into()),
-                adaptive,
-                observe_every: Some(30),
-            },
+            aspect: Reduction::free_draining(1e-3, 1.0, 2, 20, 10),
+            concentrated: Reduction::free_draining(2e-4, 1.0, 1, 50, 30),
         };
     }
     Plan {
         angles: (0..=6).map(|k| 15.0 * k as f64).collect(),
         radii: vec![75e-9, 212e-9],
-        dilute: Reduction {
-            time_step: Some(1e-3),
-            duration: Some(10.0),
-            runs: Some(2),
-            count: Some(50),
-            mobility: Some("free_draining".into()),
-            adaptive,
-            observe_every: Some(100),
-        },
+        dilute: Reduction::free_draining(1e-3, 10.0, 2, 50, 100),
         // 25 nm particles move ~5 radii per 1 ms step by diffusion alone, so the adaptive
         // stepper bisects every step several times: only the two extreme angles, fewer particles
         small: Some((
             25e-9,
             vec![0.0, 90.0],
-            Reduction {
-                time_step: Some(1e-3),
-                duration: Some(10.0),
-                runs: Some(1),
-                count: Some(20),
-                mobility: Some("free_draining".into()),
-                adaptive,
-                observe_every: Some(100),
-            },
+            Reduction::free_draining(1e-3, 10.0, 1, 20, 100),
         )),
         aspect_angles: vec![0.0, 45.0, 90.0],
-        aspect: Reduction {
-            time_step: Some(1e-3),
-            duration: Some(3.0),
-            runs: Some(2),
-            count: Some(50),
-            mobility: Some("free_draining".into()),
-            adaptive,
-            observe_every: Some(50),
-        },
-        concentrated: Reduction {
-            time_step: Some(2e-4),
-            // longer than the thesis's 1 s: without HI the cloud needs ~1 s (spec §2.9)
-            duration: Some(2.0),
-            runs: Some(1),
-            // N = 500 with dipoles and Mie contacts did not finish 2 s within 20 min here
-            // (captured particles pile up at the rim and the stepper bisects deeply)
-            count: Some(100),
-            mobility: Some("free_draining".into()),
-            adaptive,
-            observe_every: Some(50),
-        },
+        aspect: Reduction::free_draining(1e-3, 3.0, 2, 50, 50),
+        // 2 s, longer than the thesis's 1 s: without HI the cloud needs ~1 s (spec §2.9);
+        // 100 particles: N = 500 with dipoles and Mie contacts did not finish 2 s within
+        // 20 min here (captured particles pile up at the rim and the stepper bisects deeply)
+        concentrated: Reduction::free_draining(2e-4, 2.0, 1, 100, 50),
     }
 }
 

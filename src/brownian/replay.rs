@@ -17,7 +17,7 @@ use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
 
 use super::summary::{RunResult, StartRegions, summary_of};
-use crate::replay::ReplayError;
+use crate::replay::{ReplayError, last_frame, recorded_wall_time};
 use crate::scene::{Scene, parse_scene};
 use crate::sim::{RunOptions, SimError, Simulation};
 
@@ -61,12 +61,7 @@ pub fn frame_result(
         .brownian_section()
         .ok_or_else(|| bad(frame, "the recorded scene is not a brownian scene"))?;
     let config = section.config();
-    let species: Vec<u32> = scene
-        .particles
-        .iter()
-        .enumerate()
-        .flat_map(|(k, g)| std::iter::repeat_n(k as u32, g.count as usize))
-        .collect();
+    let species = scene.species_ids();
     if species.len() != frame.ids.len() {
         return Err(bad(
             frame,
@@ -117,25 +112,13 @@ pub fn start_regions(scene: &Scene) -> StartRegions {
 /// # Errors
 /// [`ReplayError`] when the recording has no frame or its state is malformed.
 pub fn replay_brownian(rec: &Recording, scene: &Scene, seed: u64) -> Result<Value, ReplayError> {
-    let frame = rec.frames.last().ok_or_else(|| {
-        ReplayError::NoFrames(
-            rec.truncated
-                .clone()
-                .map(|t| format!(" ({t})"))
-                .unwrap_or_default(),
-        )
-    })?;
+    let frame = last_frame(rec)?;
     let result = frame_result(scene, frame, seed)?;
     let config = scene
         .brownian_section()
         .map(|s| s.config())
         .unwrap_or_else(|| unreachable!("frame_result checked the scene is brownian"));
-    let wall = rec
-        .summary_json
-        .as_deref()
-        .and_then(|s| serde_json::from_str::<Value>(s).ok())
-        .and_then(|v| v.get("wall_time_s").and_then(Value::as_f64))
-        .unwrap_or(0.0);
+    let wall = recorded_wall_time(rec);
     let mut summary = summary_of(&[result], &start_regions(scene), &config, wall);
     summary["frames"] = rec.frames.len().into();
     if let Some(t) = &rec.truncated {
@@ -213,9 +196,7 @@ pub fn resume(
     on_step: impl FnMut(&World),
 ) -> Result<Value, ResumeError> {
     let rec = read_recording(path).map_err(ReplayError::from)?;
-    let meta = rec.metadata.clone().ok_or(ReplayError::NoFrames(
-        " (no magsep metadata: not written by magsep run)".into(),
-    ))?;
+    let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
     let scene = parse_scene(&meta.scene_text, &Default::default()).map_err(ReplayError::from)?;
     if scene.brownian_section().is_none() {
         return Err(ReplayError::BadFrame {
@@ -224,14 +205,7 @@ pub fn resume(
         }
         .into());
     }
-    let frame = rec.frames.last().cloned().ok_or_else(|| {
-        ReplayError::NoFrames(
-            rec.truncated
-                .clone()
-                .map(|t| format!(" ({t})"))
-                .unwrap_or_default(),
-        )
-    })?;
+    let frame = last_frame(&rec)?.clone();
     let options = RunOptions {
         seed: Some(meta.seed),
         record,

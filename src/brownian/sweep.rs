@@ -65,6 +65,26 @@ pub struct Reduction {
 }
 
 impl Reduction {
+    /// A free-draining reduction with the chart's adaptive step control (tolerance 1e-2 and a
+    /// 5-radius move limit, in radii).
+    pub fn free_draining(
+        time_step: f64,
+        duration: f64,
+        runs: u64,
+        count: u64,
+        observe_every: u64,
+    ) -> Self {
+        Self {
+            time_step: Some(time_step),
+            duration: Some(duration),
+            runs: Some(runs),
+            count: Some(count),
+            mobility: Some("free_draining".into()),
+            adaptive: Some((1e-2, 5.0)),
+            observe_every: Some(observe_every),
+        }
+    }
+
     /// The reduction as JSON (for the printed summary and the sweep files).
     pub fn to_json(&self) -> Value {
         json!({

@@ -137,6 +137,15 @@ impl Scene {
         self.particles.iter().map(|g| g.count).sum()
     }
 
+    /// The group (`[[particles]]` index) of every particle, in id order.
+    pub fn species_ids(&self) -> Vec<u32> {
+        self.particles
+            .iter()
+            .enumerate()
+            .flat_map(|(k, g)| std::iter::repeat_n(k as u32, g.count as usize))
+            .collect()
+    }
+
     /// One shape per particle, in id order.
     pub fn shapes(&self) -> Vec<Shape> {
         self.particles

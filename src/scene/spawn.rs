@@ -99,12 +99,7 @@ fn spawn_packing_particles(scene: &Scene, world: &mut World, seed: u64) -> Resul
         .map(|i| particle_stream(seed, i))
         .collect();
     let state = random_insertion(&bodies, edge, &mut rngs)?;
-    let species: Vec<u32> = scene
-        .particles
-        .iter()
-        .enumerate()
-        .flat_map(|(k, g)| std::iter::repeat_n(k as u32, g.count as usize))
-        .collect();
+    let species = scene.species_ids();
     for (i, rng) in rngs.into_iter().enumerate() {
         world.spawn(ParticleBundle {
             id: ParticleId(i as u64),

@@ -155,7 +155,8 @@ pub(crate) fn scene_update(
         ..entity(BOX_ENTITY)
     };
     let mut entities = vec![particles];
-    if frame.box_edges.min_element() > 0.0 {
+    // an unbounded run (the brownian pipeline) records zero edges: no outline
+    if frame.box_edges != DVec3::ZERO {
         entities.push(outline);
     }
     if !fibres.is_empty() {
