@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 use magsep_systems::field::{
-    CylinderSource, FieldGradient, MomentLaw, dipole_force, total_field, total_field_gradient,
+    CylinderSource, FieldGradient, MomentModel, dipole_force, total_field, total_field_gradient,
 };
 use rayon::prelude::*;
 
@@ -190,7 +190,7 @@ pub enum MapQuantity {
     FluxDensity,
     /// Attractive magnetic force [N] on a particle (`|F|` where `F` points towards the nearest
     /// fibre, 0 where it points away; thesis ch. 6 capture volume).
-    Force(MomentLaw),
+    Force(MomentModel),
 }
 
 /// A computed map: cell values `values[j][i]` on a `n x n` grid.
@@ -256,8 +256,13 @@ pub fn field_map(
 }
 
 /// `|F|` if the force on a particle at `p` points towards the nearest fibre, else 0.
-pub fn attractive_force(scene: &FieldScene, p: DVec3, law: &MomentLaw) -> f64 {
-    let f = dipole_force(&scene.gradient(p), law);
+pub fn attractive_force(scene: &FieldScene, p: DVec3, law: &MomentModel) -> f64 {
+    // the map's moments are saturated; a Langevin law is taken at 298 K
+    let f = dipole_force(
+        &scene.gradient(p),
+        law,
+        magsep_components::brownian::BOLTZMANN * 298.0,
+    );
     let nearest = scene
         .sources
         .iter()

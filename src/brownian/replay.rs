@@ -16,7 +16,7 @@ use magsep_plugins::recorder::FrameStatus;
 use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
 
-use super::summary::{RunResult, StartRegions, summary_of};
+use super::summary::{RunResult, StartRegions, is_brownian, summary_of};
 use crate::replay::{ReplayError, last_frame, recorded_wall_time};
 use crate::scene::{Scene, parse_scene};
 use crate::sim::{RunOptions, SimError, Simulation};
@@ -75,10 +75,9 @@ pub fn frame_result(
     let t = frame.time;
     let brownian = (0..frame.ids.len())
         .map(|i| {
-            let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * frame.radii[i]);
-            let d2 =
-                (frame.positions[i] - DVec3::from_array(b.initial_positions[i])).length_squared();
-            b.captured[i].is_none() && d2 < 2.0 * 6.0 * d * t
+            let x0 = DVec3::from_array(b.initial_positions[i]);
+            let d2 = (frame.positions[i] - x0).length_squared();
+            is_brownian(&config, frame.radii[i], d2, t, b.captured[i].is_some())
         })
         .collect();
     Ok(RunResult {

@@ -32,6 +32,14 @@ pub struct RunResult {
     pub stats: BrownianStats,
 }
 
+/// The Brownian criterion of thesis eq. 6.24, per particle: free, and its squared displacement
+/// `d2` [m²] from the start after time `t` [s] below twice the free-diffusion value 2·6Dt,
+/// `D = k_B T / (6 π η a)` for radius `a` [m].
+pub fn is_brownian(config: &BrownianConfig, a: f64, d2: f64, t: f64, captured: bool) -> bool {
+    let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * a);
+    !captured && d2 < 2.0 * 6.0 * d * t
+}
+
 /// Gather the [`RunResult`] of a world after (or during) a brownian run.
 pub fn run_result(world: &World, seed: u64) -> RunResult {
     let clock = *world.resource::<StepClock>();
@@ -53,10 +61,7 @@ pub fn run_result(world: &World, seed: u64) -> RunResult {
     rows.sort_by_key(|r| r.0);
     let brownian = rows
         .iter()
-        .map(|r| {
-            let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * r.5);
-            r.2.is_none() && (r.3 - r.4).length_squared() < 2.0 * 6.0 * d * t
-        })
+        .map(|r| is_brownian(config, r.5, (r.3 - r.4).length_squared(), t, r.2.is_some()))
         .collect();
     RunResult {
         seed,

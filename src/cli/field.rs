@@ -10,7 +10,7 @@ use magsep::fieldtool::{
     read_points,
 };
 use magsep::scene::load_scene;
-use magsep_systems::field::MomentLaw;
+use magsep_systems::field::MomentModel;
 
 use super::CliError;
 
@@ -93,7 +93,7 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
     }
     let quantity = match a.moment {
         Some(m) if m.is_finite() && m > 0.0 => {
-            MapQuantity::Force(MomentLaw::Saturated { moment: m })
+            MapQuantity::Force(MomentModel::Saturated { moment: m })
         }
         Some(m) => {
             return Err(CliError::input(format!(

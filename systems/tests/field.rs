@@ -5,7 +5,7 @@ use glam::{DMat3, DVec3};
 use magsep_systems::field::cylinder::{closed_form, hess_parts, inside_indicator};
 use magsep_systems::field::multipole::{self, truncation_bound};
 use magsep_systems::field::{
-    CylinderSource, Dual3, EXACT, MU0, MomentLaw, dipole_force, total_field_gradient,
+    CylinderSource, Dual3, EXACT, MU0, MomentModel, dipole_force, total_field_gradient,
 };
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -196,8 +196,8 @@ fn pose_rotation_and_superposition() {
     let tot = total_field_gradient(&[src.clone(), s2.clone()], bext, p, EXACT);
     let sum = src.field(p, EXACT).b + s2.field(p, EXACT).b + bext;
     assert!((tot.b - sum).length() < 1e-15 * sum.length());
-    let law = MomentLaw::Saturated { moment: 1e-16 };
-    let f = dipole_force(&tot, &law);
+    let law = MomentModel::Saturated { moment: 1e-16 };
+    let f = dipole_force(&tot, &law, 4.1e-21);
     // F = m ∇|B| by central differences of |B|
     let h = 1e-6;
     for j in 0..3 {

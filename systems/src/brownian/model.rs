@@ -5,7 +5,8 @@
 //! * Moments are parallel to the local flux density B = B_ext + Σ fibres (ch. 5 fields), with
 //!   magnitude from [`MomentModel`] (saturated, or Langevin eq. 6.22). Mutual induction
 //!   between particles is neglected, as in the thesis (L1677: it matters only at ~mT fields).
-//! * Field force `F = |m| ∇|B|` ([`crate::field::dipole_force`]); with no fibres the applied
+//! * Field force `F = |m| ∇|B|` ([`crate::field::dipole_force`]), computed with the moments
+//!   from one field evaluation per particle; with no fibres the applied
 //!   field is uniform and exerts no force.
 //! * Pair forces are summed per particle over a [`CellList`] in a fixed order, in parallel over
 //!   particles: bitwise identical for any thread count.
@@ -19,7 +20,6 @@ use rayon::prelude::*;
 
 use super::cells::CellList;
 use super::pair::{Mie, dipole_force};
-use crate::field::force::grad_abs_b;
 use crate::field::{CylinderSource, FieldGradient, total_field, total_field_gradient};
 
 /// Per-particle data the force model reads (all slices of length N, in `ParticleId` order).
@@ -126,38 +126,39 @@ impl ForceModel {
         total_field_gradient(&self.sources, self.b_ext, p, self.tolerance)
     }
 
-    /// Moments of every particle (B only, no gradient).
-    pub fn moments(&self, x: &[DVec3], view: &ParticleView, out: &mut [DVec3]) {
-        par_fill(out, |i, m| {
+    /// Moments of every particle and field forces on the mobile ones, from one field
+    /// evaluation per particle (with the gradient only where a force is needed).
+    pub fn moments_and_field(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        moments: &mut [DVec3],
+        field: &mut [DVec3],
+    ) {
+        let mut pairs = vec![(DVec3::ZERO, DVec3::ZERO); x.len()];
+        par_fill(&mut pairs, |i, o| {
             let law = &view.moments[i];
-            *m = if law.is_magnetic() {
+            if !law.is_magnetic() {
+                *o = (DVec3::ZERO, DVec3::ZERO);
+            } else if view.mobile[i] && !self.sources.is_empty() {
+                let g = self.field_gradient(x[i]);
+                *o = (
+                    self.moment(law, g.b),
+                    crate::field::dipole_force(&g, law, self.kt),
+                );
+            } else {
                 let b = if self.sources.is_empty() {
                     self.b_ext
                 } else {
                     total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
                 };
-                self.moment(law, b)
-            } else {
-                DVec3::ZERO
+                *o = (self.moment(law, b), DVec3::ZERO);
             }
         });
-    }
-
-    /// Field forces on the mobile particles [N].
-    pub fn field_forces(&self, x: &[DVec3], view: &ParticleView, out: &mut [DVec3]) {
-        if self.sources.is_empty() {
-            out.fill(DVec3::ZERO);
-            return;
+        for (i, (m, f)) in pairs.into_iter().enumerate() {
+            moments[i] = m;
+            field[i] = f;
         }
-        par_fill(out, |i, f| {
-            let law = &view.moments[i];
-            *f = if view.mobile[i] && law.is_magnetic() {
-                let g = self.field_gradient(x[i]);
-                magnetic_force(&g, law, self.kt)
-            } else {
-                DVec3::ZERO
-            }
-        });
     }
 
     /// Cell lists of the particles that exert pair forces: one with the dipole cut-off of the
@@ -236,42 +237,11 @@ impl ForceModel {
         if parts.field.len() != n {
             *parts = ForceParts::zeros(n);
         }
-        // moments and field forces from one field evaluation per particle
-        let pairs: Vec<(DVec3, DVec3)> = {
-            let mut v = vec![(DVec3::ZERO, DVec3::ZERO); n];
-            par_fill(&mut v, |i, o| {
-                let law = &view.moments[i];
-                if !law.is_magnetic() {
-                    *o = (DVec3::ZERO, DVec3::ZERO);
-                } else if view.mobile[i] && !self.sources.is_empty() {
-                    let g = self.field_gradient(x[i]);
-                    *o = (self.moment(law, g.b), magnetic_force(&g, law, self.kt));
-                } else if view.exerts[i] || view.mobile[i] {
-                    let b = if self.sources.is_empty() {
-                        self.b_ext
-                    } else {
-                        total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
-                    };
-                    *o = (self.moment(law, b), DVec3::ZERO);
-                }
-            });
-            v
-        };
-        for (i, (m, f)) in pairs.into_iter().enumerate() {
-            parts.moments[i] = m;
-            parts.field[i] = f;
-        }
+        self.moments_and_field(x, view, &mut parts.moments, &mut parts.field);
         let cells = self.cells(x, view);
         let moments = std::mem::take(&mut parts.moments);
         self.dipole_forces(x, &moments, view, &cells, &mut parts.dipole);
         parts.moments = moments;
         self.contact_forces(x, view, &cells, &mut parts.contact);
     }
-}
-
-/// `|m|(|B|) ∇|B|` for a moment law (the force on an induced moment parallel to B).
-pub fn magnetic_force(g: &FieldGradient, law: &MomentModel, kt: f64) -> DVec3 {
-    grad_abs_b(g)
-        .map(|(bm, grad)| grad * law.magnitude(bm, kt))
-        .unwrap_or(DVec3::ZERO)
 }

@@ -4,7 +4,7 @@
 //!
 //! | set | system | reads | writes |
 //! |---|---|---|---|
-//! | `Prepare` | [`prepare_brownian_step`] | | `BrownianWorkspace` (moments, cells) |
+//! | `Prepare` | [`prepare_brownian_step`] | | `BrownianWorkspace` (moments, field forces, cells) |
 //! | `Forces::Field` | [`compute_field_forces`] | `BrownianWorkspace` | `FieldForce`, `MagneticMoment` |
 //! | `Forces::Dipole` | [`compute_dipole_forces`] | `BrownianWorkspace` | `DipoleForce` |
 //! | `Forces::Contact` | [`compute_contact_forces`] | `BrownianWorkspace` | `ContactForce` |
@@ -45,6 +45,8 @@ pub struct BrownianWorkspace {
     pub model: ForceModel,
     /// Moments at the step start [A m²].
     pub moments: Vec<DVec3>,
+    /// Field forces at the step start [N].
+    pub field: Vec<DVec3>,
     /// Cell lists at the step start.
     pub cells: PairCells,
     /// Mobility of this step (None: free draining).
@@ -171,6 +173,7 @@ pub fn init_brownian_workspace(world: &mut World) {
     world.insert_resource(BrownianWorkspace {
         entities: rows.iter().map(|r| r.1).collect(),
         moments: vec![DVec3::ZERO; rows.len()],
+        field: vec![DVec3::ZERO; rows.len()],
         laws: rows.iter().map(|r| r.4).collect(),
         captured: rows.iter().map(|r| r.5).collect(),
         rngs: rows.iter().map(|r| r.6.clone()).collect(),
@@ -192,7 +195,8 @@ pub fn init_brownian_workspace(world: &mut World) {
     }
 }
 
-/// Moments and the cell list at the step start.
+/// Moments, field forces (one field evaluation per particle) and the cell lists at the step
+/// start.
 pub fn prepare_brownian_step(mut ws: ResMut<BrownianWorkspace>, config: Res<BrownianConfig>) {
     let ws = &mut *ws;
     let mobile = ws.mobile();
@@ -203,10 +207,16 @@ pub fn prepare_brownian_step(mut ws: ResMut<BrownianWorkspace>, config: Res<Brow
         mobile: &mobile,
         exerts: &exerts,
     };
-    let mut m = std::mem::take(&mut ws.moments);
-    m.resize(ws.positions.len(), DVec3::ZERO);
-    ws.model.moments(&ws.positions, &view, &mut m);
-    ws.moments = m;
+    let n = ws.positions.len();
+    let (mut m, mut f) = (
+        std::mem::take(&mut ws.moments),
+        std::mem::take(&mut ws.field),
+    );
+    m.resize(n, DVec3::ZERO);
+    f.resize(n, DVec3::ZERO);
+    ws.model
+        .moments_and_field(&ws.positions, &view, &mut m, &mut f);
+    (ws.moments, ws.field) = (m, f);
     ws.cells = ws.model.cells(&ws.positions, &view);
 }
 
@@ -223,22 +233,13 @@ fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
     }
 }
 
-/// Field forces and moments.
+/// Field forces and moments (computed in `Prepare` with the moments the dipole forces need).
 pub fn compute_field_forces(
     ws: Res<BrownianWorkspace>,
     mut forces: Query<&mut FieldForce>,
     mut moments: Query<&mut MagneticMoment>,
 ) {
-    let mobile = ws.mobile();
-    let view = ParticleView {
-        radii: &ws.radii,
-        moments: &ws.laws,
-        mobile: &mobile,
-        exerts: &mobile,
-    };
-    let mut f = vec![DVec3::ZERO; ws.positions.len()];
-    ws.model.field_forces(&ws.positions, &view, &mut f);
-    write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws, &ws.field, &mut forces, |c, v| c.0 = v);
     write_dense(&ws, &ws.moments, &mut moments, |c, v| c.0 = v);
 }
 

@@ -30,7 +30,7 @@ pub mod multipole;
 pub mod real;
 pub mod source;
 
-pub use force::{MomentLaw, dipole_force};
+pub use force::{MomentModel, dipole_force};
 pub use real::{Dual3, Real};
 pub use source::{
     CylinderSource, EXACT, FieldGradient, FieldValue, MU0, total_field, total_field_gradient,
