@@ -2,6 +2,7 @@
 //! `magsep_systems::geometry`.
 
 use bevy_ecs::prelude::Component;
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 /// Shape of a particle, in its body frame (symmetry axis along body z).
@@ -20,26 +21,46 @@ pub enum Shape {
         /// Half the length of the cylindrical part, L/2 [m].
         half_length: f64,
     },
+    /// A superquadric |x/a1|^g1 + |y/a2|^g2 + |z/a3|^g3 <= 1 (thesis 000, eq. 4.3). Exponents
+    /// g = 2 give an ellipsoid (a spheroid when two semi-axes agree); equal semi-axes and
+    /// exponents give a superball (a sphere at g = 2, a cube as g -> infinity).
+    Superquadric {
+        /// Semi-axes (a1, a2, a3) along body x, y, z [m].
+        semi_axes: DVec3,
+        /// Shape exponents (g1, g2, g3), each >= 2 (strictly convex), dimensionless.
+        exponents: DVec3,
+    },
 }
 
 impl Shape {
-    /// Radius R [m] (of the sphere, or of the rod's cylinder and caps).
+    /// Radius R [m] (of the sphere, or of the rod's cylinder and caps); the smallest semi-axis
+    /// of a superquadric.
     pub fn radius(&self) -> f64 {
         match *self {
             Shape::Sphere { radius } | Shape::Spherocylinder { radius, .. } => radius,
+            Shape::Superquadric { semi_axes, .. } => semi_axes.min_element(),
         }
     }
 
-    /// Half length of the axis segment [m]; zero for a sphere.
+    /// Half length of the axis segment [m]; zero for a sphere and a superquadric.
     pub fn half_length(&self) -> f64 {
         match *self {
-            Shape::Sphere { .. } => 0.0,
+            Shape::Sphere { .. } | Shape::Superquadric { .. } => 0.0,
             Shape::Spherocylinder { half_length, .. } => half_length,
         }
     }
 
-    /// Aspect ratio (L + D) / D (thesis 000, eq. 2.1); 1 for a sphere.
+    /// Whether this is a superquadric.
+    pub fn is_superquadric(&self) -> bool {
+        matches!(self, Shape::Superquadric { .. })
+    }
+
+    /// Aspect ratio (L + D) / D (thesis 000, eq. 2.1); 1 for a sphere; largest over smallest
+    /// semi-axis for a superquadric.
     pub fn aspect_ratio(&self) -> f64 {
-        1.0 + self.half_length() / self.radius()
+        match *self {
+            Shape::Superquadric { semi_axes, .. } => semi_axes.max_element() / semi_axes.min_element(),
+            _ => 1.0 + self.half_length() / self.radius(),
+        }
     }
 }

@@ -1,7 +1,10 @@
 //! Characterisation of packings: contact numbers, orientational order, pair correlation.
 
 pub mod contacts;
+pub mod confinement;
+pub mod cubatic;
 pub mod order;
+pub mod wall_order;
 
 pub use contacts::{ContactNumbers, contact_numbers};
 pub use order::{nematic_order, symmetric_eigenvalues};

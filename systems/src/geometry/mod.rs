@@ -2,6 +2,7 @@
 
 pub mod segment;
 pub mod shape;
+pub mod superquadric;
 
 pub use segment::{SegmentClosest, segment_closest};
 pub use shape::{bounding_radius, inertia_body_unit_density, volume};

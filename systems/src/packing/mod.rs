@@ -14,3 +14,4 @@ pub mod neighbour;
 pub mod removal;
 pub mod state;
 pub mod systems;
+pub mod walls;

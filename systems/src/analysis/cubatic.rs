@@ -1,0 +1,1 @@
+//! cubatic (placeholder, being written).

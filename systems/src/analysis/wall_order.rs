@@ -1,0 +1,1 @@
+//! wall_order (placeholder, being written).

@@ -1,0 +1,1 @@
+//! Superquadric geometry and contact (placeholder, being written).

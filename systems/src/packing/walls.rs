@@ -1,0 +1,1 @@
+//! Virtual-particle walls (placeholder, being written).
