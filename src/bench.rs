@@ -14,7 +14,10 @@ use magsep_systems::packing::insert::random_insertion;
 use magsep_systems::packing::neighbour::NeighbourList;
 use magsep_systems::packing::removal::overlap_scan;
 use magsep_systems::packing::state::{Body, PackingState};
-use magsep_systems::packing::systems::MCM_SKIN;
+use magsep_systems::packing::systems::{MCM_SKIN, state_from_si};
+
+use crate::scene::ContainerSpec;
+use crate::scene::packing_geometry::start_container;
 use magsep_systems::rng::{DRIVER_STREAM, particle_stream};
 use serde_json::{Value, json};
 
@@ -46,6 +49,12 @@ pub struct PackingRun {
     pub attempts: u64,
     /// Wall time [s].
     pub wall_time_s: f64,
+    /// Pair contacts evaluated.
+    pub contact_evaluations: u64,
+    /// Of which the superquadric solver fell back to GJK/EPA.
+    pub contact_fallbacks: u64,
+    /// Final state (reduced units), wrapped.
+    pub state: PackingState,
 }
 
 /// A monodisperse run: `n` particles of `shape` (reduced units, D = 1) with `config`,
@@ -57,12 +66,25 @@ pub fn packing_run(
     seed: u64,
     stop_at: f64,
 ) -> Result<PackingRun, BenchError> {
+    packing_run_in(n, shape, config, seed, stop_at, &ContainerSpec::PeriodicBox {})
+}
+
+/// [`packing_run`] in the container `spec` (SI lengths = reduced units here, D = 1).
+pub fn packing_run_in(
+    n: usize,
+    shape: Shape,
+    config: &PackingConfig,
+    seed: u64,
+    stop_at: f64,
+    spec: &ContainerSpec,
+) -> Result<PackingRun, BenchError> {
     let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
     let vp: f64 = bodies.iter().map(|b| b.volume).sum();
-    let edge = (vp / config.initial_packing_fraction).cbrt();
+    let container = start_container(spec, vp, config.initial_packing_fraction);
+    let empty = state_from_si(&container, &[], &[], &[], 1.0);
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
     let t0 = Instant::now();
-    let mut state = random_insertion(&bodies, edge, &mut rngs)
+    let mut state = random_insertion(&bodies, empty, &mut rngs)
         .map_err(|e| BenchError::Runtime(e.to_string()))?;
     let p = DriverParams::from_config(config, 1.0);
     let mut list = NeighbourList::new(MCM_SKIN);
@@ -85,6 +107,9 @@ pub fn packing_run(
         steps: st.compression_steps,
         attempts: st.attempts,
         wall_time_s: wall,
+        contact_evaluations: st.contact_evaluations,
+        contact_fallbacks: st.contact_fallbacks,
+        state,
     })
 }
 
@@ -99,7 +124,7 @@ fn loose_spheres(
         .collect();
     let vp: f64 = bodies.iter().map(|b| b.volume).sum();
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
-    let mut state = random_insertion(&bodies, (vp / phi).cbrt(), &mut rngs)
+    let mut state = random_insertion(&bodies, PackingState::periodic_cube((vp / phi).cbrt()), &mut rngs)
         .map_err(|e| BenchError::Runtime(e.to_string()))?;
     let mut list = NeighbourList::new(MCM_SKIN);
     list.build(&mut state);
@@ -248,6 +273,21 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
     if what == "brownian" {
         return crate::brownian::chart::chart_brownian(out, quick);
     }
+    match what {
+        "cylinder" => return crate::packing_charts::chart_cylinder(out, quick),
+        "wedge" => return crate::packing_charts::chart_wedge(out, quick),
+        "superballs" => return crate::packing_charts::chart_superballs(out, quick),
+        "sq-contact" => {
+            std::fs::create_dir_all(out)
+                .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
+            let study = crate::sq_study::run_sq_contact_study(quick);
+            let summary = crate::sq_study::write_sq_study(&study, out)
+                .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
+            println!("{summary}");
+            return Ok(());
+        }
+        _ => {}
+    }
     if what == "field" {
         let rows = crate::bench_field::chart_field(out, quick)?;
         println!(
@@ -258,7 +298,7 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
     }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown chart `{what}`; available: packing, field, brownian, brownian-cost"
+            "unknown chart `{what}`; available: packing, cylinder, wedge, superballs, sq-contact, field, brownian, brownian-cost"
         )));
     }
     std::fs::create_dir_all(out)
@@ -435,7 +475,7 @@ mod tests {
     #[test]
     fn removal_budget_of_fire_counts_iterations_times_n() {
         let (mut state, mut list) = loose_spheres(50, 0.3, 1).unwrap();
-        state.scale(0.9);
+        state.scale(glam::DVec3::splat(0.9));
         let mut cfg = PackingConfig::defaults_for(50, 1.0);
         cfg.max_attempts = 50 * 3;
         let p = DriverParams::from_config(&cfg, 1.0);

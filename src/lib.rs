@@ -19,8 +19,10 @@ pub mod bench_field;
 pub mod brownian;
 pub mod chart;
 pub mod fieldtool;
+pub mod packing_charts;
 pub mod replay;
 pub mod scene;
+pub mod sq_study;
 pub mod sim;
 pub mod summary;
 

@@ -3,7 +3,6 @@
 use std::path::Path;
 
 use bevy_ecs::prelude::*;
-use glam::DVec3;
 use magsep_components::prelude::*;
 use magsep_plugins::app::SimApp;
 use magsep_plugins::packing::PackingObservePlugin;
@@ -43,10 +42,16 @@ pub enum ReplayError {
 }
 
 /// Spawn the particles of `frame` into `world` and set the container, clock and status.
+/// `shapes` (in id order, from the recorded scene) override the frame's radii and half
+/// lengths, which cannot describe superquadrics.
 ///
 /// # Errors
 /// [`ReplayError::BadFrame`] for non-positive radii or a malformed status.
-pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), ReplayError> {
+pub fn load_frame(
+    world: &mut World,
+    frame: &ParticleFrame,
+    shapes: Option<&[Shape]>,
+) -> Result<(), ReplayError> {
     let bad = |detail: String| ReplayError::BadFrame {
         step: frame.step,
         detail,
@@ -56,7 +61,12 @@ pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Replay
         if !(r.is_finite() && r > 0.0 && h.is_finite() && h >= 0.0) {
             return Err(bad(format!("particle {id}: radius {r}, half length {h}")));
         }
-        let shape = if h == 0.0 {
+        let scene_shape = shapes
+            .filter(|s| s.len() == frame.ids.len())
+            .map(|s| s[i]);
+        let shape = if let Some(s) = scene_shape {
+            s
+        } else if h == 0.0 {
             Shape::Sphere { radius: r }
         } else {
             Shape::Spherocylinder {
@@ -79,9 +89,13 @@ pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Replay
     if !(e.is_finite() && e.min_element() > 0.0) {
         return Err(bad(format!("box edges {e}")));
     }
-    world.insert_resource(Container::PeriodicBox {
-        edges: DVec3::new(e.x, e.y, e.z),
-    });
+    let status: FrameStatus =
+        serde_json::from_str(&frame.status_json).map_err(|e| bad(format!("status_json: {e}")))?;
+    let container = match status.container {
+        Some(Container::Walled { walls, .. }) => Container::Walled { walls, edges: e },
+        _ => Container::PeriodicBox { edges: e },
+    };
+    world.insert_resource(container);
     world.insert_resource(StepClock {
         step: frame.step,
         dt: if frame.step > 0 {
@@ -90,8 +104,6 @@ pub fn load_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Replay
             0.0
         },
     });
-    let status: FrameStatus =
-        serde_json::from_str(&frame.status_json).map_err(|e| bad(format!("status_json: {e}")))?;
     if let Some(s) = status.packing {
         world.insert_resource(s);
     }
@@ -138,7 +150,7 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
     let frame = last_frame(&rec)?;
     let mut app = SimApp::new();
     app.world.insert_resource(scene.packing_config());
-    load_frame(&mut app.world, frame)?;
+    load_frame(&mut app.world, frame, Some(&scene.shapes()))?;
     app.add_plugin(&PackingObservePlugin);
     app.finish().map_err(|e| ReplayError::BadFrame {
         step: frame.step,

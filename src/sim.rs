@@ -132,6 +132,25 @@ impl Simulation {
                     })
                     .collect(),
             );
+            writer.set_walls(app.world.resource::<Container>().walls());
+            let mut shapes: Vec<_> = app
+                .world
+                .query::<(&ParticleId, &Shape)>()
+                .iter(&app.world)
+                .map(|(id, s)| (*id, *s))
+                .collect();
+            shapes.sort_by_key(|r| r.0);
+            if shapes.iter().any(|r| r.1.is_superquadric()) {
+                writer.set_semi_axes(
+                    shapes
+                        .iter()
+                        .map(|r| match r.1 {
+                            Shape::Superquadric { semi_axes, .. } => semi_axes,
+                            _ => glam::DVec3::ZERO,
+                        })
+                        .collect(),
+                );
+            }
             let every = app
                 .world
                 .get_resource::<RecordEvery>()

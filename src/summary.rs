@@ -51,6 +51,12 @@ pub fn packing_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
                 "the finest volume step is a linear strain of {e:.2e} (> 1e-3): the packing may not be jammed; use a smaller volume_step or more step_halvings"
             ));
         }
+        if s.contact_fallbacks * 1000 > s.contact_evaluations {
+            warnings.push(format!(
+                "the superquadric contact solver fell back to GJK/EPA in {} of {} contacts (> 0.1 %)",
+                s.contact_fallbacks, s.contact_evaluations
+            ));
+        }
         match s.stopped {
             Some(StopReason::BudgetTooSmall) => warnings.push(
                 "no compression step succeeded: the volume step is too large for the attempt budget (max_attempts); the reported packing is the start configuration".into(),
@@ -67,6 +73,12 @@ pub fn packing_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
         "mean_contact_number_at_1e-4": obs.mean_contact_number_1e_4,
         "nematic_order": obs.nematic_order,
         "max_overlap": obs.max_overlap,
+        "container": container.map(|c| serde_json::to_value(c).unwrap_or(Value::Null)),
+        "wall_aligned_fraction": obs.wall_aligned_fraction,
+        "cubatic_order": obs.cubatic_order,
+        "max_wall_penetration": obs.max_wall_penetration,
+        "contact_evaluations": status.map(|s| s.contact_evaluations),
+        "contact_fallbacks": status.map(|s| s.contact_fallbacks),
         "compression_steps": status.map(|s| s.compression_steps),
         "failed_steps": status.map(|s| s.failed_steps),
         "attempts": status.map(|s| s.attempts),

@@ -9,7 +9,7 @@ use magsep_components::shape::Shape;
 use magsep_systems::packing::compress::{DriverParams, compression_step, initial_status};
 use magsep_systems::packing::insert::random_insertion;
 use magsep_systems::packing::neighbour::NeighbourList;
-use magsep_systems::packing::state::Body;
+use magsep_systems::packing::state::{Body, PackingState};
 use magsep_systems::rng::particle_stream;
 
 const SPHERE: Shape = Shape::Sphere { radius: 0.5 };
@@ -146,7 +146,12 @@ fn a_volume_step_too_large_for_the_budget_ends_early_with_a_clear_report() {
     let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&SPHERE, 1.0)).collect();
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(3, i)).collect();
     let volume: f64 = bodies.iter().map(|b| b.volume).sum();
-    let mut state = random_insertion(&bodies, (volume / 0.3).cbrt(), &mut rngs).unwrap();
+    let mut state = random_insertion(
+        &bodies,
+        PackingState::periodic_cube((volume / 0.3).cbrt()),
+        &mut rngs,
+    )
+    .unwrap();
     let mut cfg = PackingConfig::defaults_for(n, 1.0);
     cfg.scheme = OverlapRemovalScheme::Revised;
     cfg.volume_step_rule = VolumeStepRule::Fixed;
@@ -164,7 +169,7 @@ fn a_volume_step_too_large_for_the_budget_ends_early_with_a_clear_report() {
     assert_eq!(st.stopped, Some(StopReason::BudgetTooSmall));
     assert_eq!(st.compression_steps, 0);
     // the reported state is the overlap-free start, not a half-compressed overlapping one
-    assert_eq!(state.edge, start.edge);
+    assert_eq!(state.edges, start.edges);
     assert_eq!(state.positions, start.positions);
 }
 

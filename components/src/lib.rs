@@ -30,7 +30,7 @@ pub mod prelude {
         MomentModel, StepControl,
     };
     pub use crate::clock::StepClock;
-    pub use crate::container::Container;
+    pub use crate::container::{Container, Walls};
     pub use crate::fibre::{ExternalField, Fibre, FibreId};
     pub use crate::forces::{ForceContribution, NetForce, NetTorque};
     pub use crate::health::Health;

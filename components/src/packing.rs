@@ -142,4 +142,11 @@ pub struct PackingStatus {
     pub packing_fraction: f64,
     /// Set when the run ended.
     pub stopped: Option<StopReason>,
+    /// Pair contacts evaluated in overlap scans (all steps).
+    #[serde(default)]
+    pub contact_evaluations: u64,
+    /// Of which the superquadric contact solver did not converge and its GJK/EPA estimate was
+    /// used instead (counted, never dropped).
+    #[serde(default)]
+    pub contact_fallbacks: u64,
 }

@@ -37,6 +37,9 @@ pub struct FrameStatus {
     pub packing: Option<PackingStatus>,
     /// Packing driver random stream (xoshiro256++ words).
     pub driver_rng: Option<[u64; 4]>,
+    /// The container (walls and box) of the frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub container: Option<Container>,
     /// Brownian pipeline state beyond positions and random streams.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub brownian: Option<BrownianFrameStatus>,
@@ -104,6 +107,7 @@ pub fn gather_frame(
     let fs = FrameStatus {
         packing: status.copied(),
         driver_rng: ws.map(|w| rng_state_words(&w.rng)),
+        container: container.walls().map(|_| *container),
         brownian: brownian.map(|stats| BrownianFrameStatus {
             captured: rows.iter().map(|r| r.5.and_then(|c| c.0)).collect(),
             initial_positions: rows

@@ -19,7 +19,9 @@
 mod brownian;
 #[cfg(test)]
 mod brownian_tests;
+mod fibre_packing;
 mod fibres;
+pub mod packing_geometry;
 mod placement;
 mod sections;
 mod spawn;
@@ -33,6 +35,7 @@ use std::path::Path;
 use bevy_ecs::prelude::*;
 
 pub use brownian::{BrownianSection, PlacementSpec};
+pub use fibre_packing::FibrePackingSpec;
 pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use sections::{
     ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec,
@@ -154,6 +157,7 @@ pub const CORE_KEYS: &[&str] = &[
     "packing",
     "record",
     "fibres",
+    "fibre_packings",
     "external_field",
     "brownian",
 ];

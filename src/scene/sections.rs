@@ -1,6 +1,7 @@
 //! Typed scene sections (serde, `deny_unknown_fields`, tagged enums). SI units.
 
 use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
+use glam::DVec3;
 use magsep_components::shape::Shape;
 use serde::{Deserialize, Serialize};
 
@@ -33,6 +34,30 @@ pub struct SimulationSection {
 pub enum ContainerSpec {
     /// A periodic cube; its edge follows from `packing.initial_packing_fraction`.
     PeriodicBox {},
+    /// A hard cylinder wall (thesis 000, ch. 2), periodic along its axis (z) and compressed
+    /// along it only; its start length follows from `packing.initial_packing_fraction`.
+    Cylinder {
+        /// Radius of the cylinder R_cyl = D_cyl / 2 [m], fixed. Range: > the largest
+        /// particle radius.
+        radius: f64,
+    },
+    /// A hard wedge prism (thesis 000, ch. 2): bottom y = 0, back x = `length`, slope
+    /// y = x tan(`angle`); periodic in z (its width) and compressed along it only.
+    Wedge {
+        /// Acute angle alpha between bottom and slope [rad]. Range: (0, pi/2).
+        angle: f64,
+        /// Length l_w of the wedge along x [m], fixed. Range: > 0 and room for a particle.
+        length: f64,
+    },
+    /// Two hard walls z = 0 and z = height, periodic in x and y with the fixed side `side`;
+    /// compressed along z; the start height follows from `packing.initial_packing_fraction`.
+    Slab {
+        /// Periodic side along x and y [m]. Range: > 0.
+        side: f64,
+    },
+    /// A closed box of six hard walls, compressed isotropically; its start edge follows from
+    /// `packing.initial_packing_fraction`.
+    ClosedBox {},
 }
 
 /// A particle shape in a scene.
@@ -52,6 +77,25 @@ pub enum ShapeSpec {
         /// Length L of the cylindrical part [m]. Range: >= 0.
         cylinder_length: f64,
     },
+    /// Superquadric |x/a1|^g1 + |y/a2|^g2 + |z/a3|^g3 <= 1 (thesis 000, eq. 4.3).
+    Superquadric {
+        /// Semi-axes (a1, a2, a3) [m]. Range: each > 0.
+        semi_axes: [f64; 3],
+        /// Exponents (g1, g2, g3). Range: each in [2, 20] (strictly convex).
+        exponents: [f64; 3],
+    },
+    /// Superball |x|^g + |y|^g + |z|^g <= a^g (g = 2: sphere; g -> infinity: cube of side 2a).
+    Superball {
+        /// Semi-axis a (half the side of the enclosing cube) [m]. Range: > 0.
+        semi_axis: f64,
+        /// Exponent g. Range: [2, 20].
+        exponent: f64,
+    },
+    /// Ellipsoid (x/a1)^2 + (y/a2)^2 + (z/a3)^2 <= 1 (a spheroid when two semi-axes agree).
+    Ellipsoid {
+        /// Semi-axes (a1, a2, a3) [m]. Range: each > 0.
+        semi_axes: [f64; 3],
+    },
 }
 
 impl ShapeSpec {
@@ -65,6 +109,24 @@ impl ShapeSpec {
             } => Shape::Spherocylinder {
                 radius,
                 half_length: 0.5 * cylinder_length,
+            },
+            ShapeSpec::Superquadric {
+                semi_axes,
+                exponents,
+            } => Shape::Superquadric {
+                semi_axes: DVec3::from_array(semi_axes),
+                exponents: DVec3::from_array(exponents),
+            },
+            ShapeSpec::Superball {
+                semi_axis,
+                exponent,
+            } => Shape::Superquadric {
+                semi_axes: DVec3::splat(semi_axis),
+                exponents: DVec3::splat(exponent),
+            },
+            ShapeSpec::Ellipsoid { semi_axes } => Shape::Superquadric {
+                semi_axes: DVec3::from_array(semi_axes),
+                exponents: DVec3::splat(2.0),
             },
         }
     }

@@ -1,11 +1,14 @@
 //! Spawn a validated scene into a world.
 
 use bevy_ecs::prelude::*;
-use glam::DVec3;
 use magsep_components::prelude::*;
 use magsep_systems::RunSeed;
 use magsep_systems::packing::insert::{InsertionError, random_insertion};
 use magsep_systems::packing::state::Body;
+use magsep_systems::packing::systems::state_from_si;
+
+use super::packing_geometry::start_container;
+use super::sections::ContainerSpec;
 use magsep_systems::rng::particle_stream;
 
 use super::{Scene, SceneRegistry};
@@ -94,11 +97,13 @@ fn spawn_packing_particles(scene: &Scene, world: &mut World, seed: u64) -> Resul
     let d = scene.reference_diameter();
     let bodies: Vec<Body> = shapes.iter().map(|s| Body::from_shape(s, d)).collect();
     let volume: f64 = bodies.iter().map(|b| b.volume).sum();
-    let edge = (volume / config.initial_packing_fraction).cbrt();
+    let spec = scene.container.clone().unwrap_or(ContainerSpec::PeriodicBox {});
+    let container = start_container(&spec, volume * d.powi(3), config.initial_packing_fraction);
     let mut rngs: Vec<_> = (0..shapes.len() as u64)
         .map(|i| particle_stream(seed, i))
         .collect();
-    let state = random_insertion(&bodies, edge, &mut rngs)?;
+    let empty = state_from_si(&container, &[], &[], &[], d);
+    let state = random_insertion(&bodies, empty, &mut rngs)?;
     let species = scene.species_ids();
     for (i, rng) in rngs.into_iter().enumerate() {
         world.spawn(ParticleBundle {
@@ -112,9 +117,12 @@ fn spawn_packing_particles(scene: &Scene, world: &mut World, seed: u64) -> Resul
             net_torque: NetTorque::default(),
         });
     }
-    world.insert_resource(Container::PeriodicBox {
-        edges: DVec3::splat(edge * d),
-    });
+    if let Some(walls) = container.walls() {
+        for face in walls.faces() {
+            world.spawn(face);
+        }
+    }
+    world.insert_resource(container);
     world.insert_resource(config);
     world.insert_resource(StepClock::new(0.0));
     Ok(())

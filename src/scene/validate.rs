@@ -3,6 +3,7 @@
 use serde::de::DeserializeOwned;
 
 use super::brownian::{BrownianSection, validate_group, validate_section};
+use super::fibre_packing::FibrePackingSpec;
 use super::fibres::{ExternalFieldSection, FibreSpec, validate_fibres};
 use super::sections::*;
 use super::{CORE_KEYS, Scene, SceneError, SceneRegistry};
@@ -102,13 +103,13 @@ fn typed_array<T: DeserializeOwned>(
     }
 }
 
-fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl FnOnce() -> String) {
+pub(super) fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl FnOnce() -> String) {
     if !ok {
         errors.push(SceneError::new(path, message()));
     }
 }
 
-fn finite_positive(errors: &mut Vec<SceneError>, path: &str, v: f64) {
+pub(super) fn finite_positive(errors: &mut Vec<SceneError>, path: &str, v: f64) {
     check(errors, v.is_finite() && v > 0.0, path, || {
         format!("must be a finite number > 0, got {v}")
     });
@@ -145,6 +146,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut record = None;
     let mut extensions = Vec::new();
     let mut fibres = Vec::new();
+    let mut fibre_packings = Vec::new();
     let mut external_field = None;
     let mut brownian = None;
     for (key, value) in &table {
@@ -162,6 +164,9 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 external_field = typed::<ExternalFieldSection>(value, "external_field", &mut errors)
             }
             "fibres" => fibres = typed_array::<FibreSpec>(value, "fibres", &mut errors),
+            "fibre_packings" => {
+                fibre_packings = typed_array::<FibrePackingSpec>(value, "fibre_packings", &mut errors)
+            }
             "particles" => {
                 particles = typed_array::<ParticleGroup>(value, "particles", &mut errors)
             }
@@ -185,7 +190,9 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let field_only = !table.contains_key("simulation")
         && !table.contains_key("particles")
         && !table.contains_key("container")
-        && (table.contains_key("fibres") || table.contains_key("external_field"));
+        && (table.contains_key("fibres")
+            || table.contains_key("fibre_packings")
+            || table.contains_key("external_field"));
     if !field_only && !table.contains_key("simulation") {
         errors.push(SceneError::new(
             "simulation",
@@ -232,6 +239,14 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             "only for pipeline = \"brownian\"",
         ));
     }
+    // fibres from packing recordings, appended after the explicit ones (reported under
+    // fibre_packings[i] when invalid)
+    for (i, spec) in &fibre_packings {
+        let first = fibres.len();
+        for f in super::fibre_packing::expand(*i, spec, &mut errors) {
+            fibres.push((first, f));
+        }
+    }
     let fibre_specs: Vec<FibreSpec> = fibres.iter().map(|(_, f)| f.clone()).collect();
     // semantic checks
     let mut total: u64 = 0;
@@ -273,6 +288,37 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
         match g.shape {
             ShapeSpec::Sphere { radius } => {
                 finite_positive(&mut errors, &format!("{p}.shape.radius"), radius)
+            }
+            ShapeSpec::Superquadric {
+                semi_axes,
+                exponents,
+            } => {
+                for (k, a) in semi_axes.iter().enumerate() {
+                    finite_positive(&mut errors, &format!("{p}.shape.semi_axes[{k}]"), *a);
+                }
+                for (k, g) in exponents.iter().enumerate() {
+                    super::packing_geometry::exponent_in_range(
+                        &mut errors,
+                        &format!("{p}.shape.exponents[{k}]"),
+                        *g,
+                    );
+                }
+            }
+            ShapeSpec::Superball {
+                semi_axis,
+                exponent,
+            } => {
+                finite_positive(&mut errors, &format!("{p}.shape.semi_axis"), semi_axis);
+                super::packing_geometry::exponent_in_range(
+                    &mut errors,
+                    &format!("{p}.shape.exponent"),
+                    exponent,
+                );
+            }
+            ShapeSpec::Ellipsoid { semi_axes } => {
+                for (k, a) in semi_axes.iter().enumerate() {
+                    finite_positive(&mut errors, &format!("{p}.shape.semi_axes[{k}]"), *a);
+                }
             }
             ShapeSpec::Spherocylinder {
                 radius,
@@ -346,6 +392,10 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
         check(&mut errors, v >= 1, "packing.max_compression_steps", || {
             format!("must be >= 1, got {v}")
         });
+    }
+    if errors.is_empty() && !is_brownian && !field_only {
+        let groups: Vec<&ParticleGroup> = particles.iter().map(|(_, g)| g).collect();
+        super::packing_geometry::validate(container.as_ref(), &groups, &packing, &mut errors);
     }
     if let Some(r) = &record {
         check(&mut errors, r.every >= 1, "record.every", || {

@@ -48,12 +48,8 @@ fn configuration(seed: u64) -> PackingState {
     );
     let mut rng = particle_stream(seed, 0);
     loop {
-        let mut s = PackingState {
-            edge: 1000.0,
-            positions: vec![],
-            orientations: vec![],
-            bodies: vec![body; 3],
-        };
+        let mut s = PackingState::periodic_cube(1000.0);
+        s.bodies = vec![body; 3];
         for _ in 0..3 {
             let p = DVec3::new(
                 rng.random_range(-1.0..1.0),

@@ -2,10 +2,12 @@
 
 use super::{FibreShape, ParticleFrame, SCENE_FRAME_ID};
 use foxglove::messages::{
-    Color, CylinderPrimitive, Duration, LinePrimitive, Point3, Pose, Quaternion, SceneEntity,
-    SceneUpdate, SpherePrimitive, Timestamp, Vector3, line_primitive,
+    Color, CubePrimitive, CylinderPrimitive, Duration, LinePrimitive, Point3, Pose, Quaternion,
+    SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, TriangleListPrimitive, Vector3,
+    line_primitive,
 };
 use glam::{DQuat, DVec3};
+use magsep_components::container::Walls;
 
 /// Entity id of the particles.
 pub(crate) const PARTICLES_ENTITY: &str = "particles";
@@ -79,22 +81,94 @@ pub(crate) fn box_edge_points(e: DVec3) -> Vec<Point3> {
     points
 }
 
+/// What a scene update draws besides the particles.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct SceneDecor {
+    /// Fibres (entity `fibres`).
+    pub fibres: Vec<FibreShape>,
+    /// Hard walls (entity `walls`), sized from the frame's box edges.
+    pub walls: Option<Walls>,
+    /// Per-particle superquadric semi-axes (zero: sphere or rod); empty: none.
+    pub semi_axes: Vec<DVec3>,
+}
+
+/// Id of the walls entity.
+pub const WALLS_ENTITY: &str = "walls";
+/// Colour of walls (translucent grey).
+const WALL_COLOUR: [f32; 4] = [0.7, 0.7, 0.75, 0.25];
+
+/// The wall primitives of `walls` in the box `[0, e]`: a cylinder, the wedge's three faces
+/// as triangles, or the slab's two plates (a closed box is its outline).
+fn wall_entity(walls: Walls, e: DVec3, entity: SceneEntity) -> SceneEntity {
+    let col = colour(WALL_COLOUR);
+    let p3 = |x: f64, y: f64, z: f64| Point3 { x, y, z };
+    match walls {
+        Walls::Cylinder => SceneEntity {
+            cylinders: vec![CylinderPrimitive {
+                pose: pose(0.5 * e, DQuat::IDENTITY),
+                size: Some(vec3(e)),
+                bottom_scale: 1.0,
+                top_scale: 1.0,
+                color: col,
+            }],
+            ..entity
+        },
+        Walls::Wedge { .. } => {
+            // faces: bottom (y = 0), back (x = e.x), slope (through the z axis), two triangles each
+            let quads = [
+                [p3(0.0, 0.0, 0.0), p3(e.x, 0.0, 0.0), p3(e.x, 0.0, e.z), p3(0.0, 0.0, e.z)],
+                [p3(e.x, 0.0, 0.0), p3(e.x, e.y, 0.0), p3(e.x, e.y, e.z), p3(e.x, 0.0, e.z)],
+                [p3(0.0, 0.0, 0.0), p3(e.x, e.y, 0.0), p3(e.x, e.y, e.z), p3(0.0, 0.0, e.z)],
+            ];
+            let mut points = Vec::with_capacity(18);
+            for q in quads {
+                for k in [0, 1, 2, 0, 2, 3] {
+                    points.push(q[k].clone());
+                }
+            }
+            SceneEntity {
+                triangles: vec![TriangleListPrimitive {
+                    pose: pose(DVec3::ZERO, DQuat::IDENTITY),
+                    points,
+                    color: col,
+                    ..Default::default()
+                }],
+                ..entity
+            }
+        }
+        Walls::Slab => {
+            let plate = |z: f64| CubePrimitive {
+                pose: pose(DVec3::new(0.5 * e.x, 0.5 * e.y, z), DQuat::IDENTITY),
+                size: Some(vec3(DVec3::new(e.x, e.y, 1e-3 * e.x.max(e.y)))),
+                color: col,
+            };
+            SceneEntity {
+                cubes: vec![plate(0.0), plate(e.z)],
+                ..entity
+            }
+        }
+        Walls::Box => entity,
+    }
+}
+
 /// Id of the fibres entity.
 pub const FIBRES_ENTITY: &str = "fibres";
 /// Colour of fibres (steel grey).
 const FIBRE_COLOUR: [f32; 4] = [0.55, 0.57, 0.62, 1.0];
 
 /// Builds the scene of `frame`: entity `particles` (a sphere of diameter 2R per sphere;
-/// a cylinder of size (2R, 2R, 2h) plus two end spheres per capsule), entity `box`, and entity
-/// `fibres` (one cylinder per fibre) when there are fibres.
+/// a cylinder of size (2R, 2R, 2h) plus two end spheres per capsule; an ellipsoid of the
+/// semi-axes per superquadric), entity `box`, entity `walls` when there are hard walls, and
+/// entity `fibres` (one cylinder per fibre) when there are fibres.
 ///
 /// `frame`'s arrays must have equal lengths; `colours`, if given, one entry per particle.
 pub(crate) fn scene_update(
     frame: &ParticleFrame,
     colours: Option<&[[f32; 4]]>,
-    fibres: &[FibreShape],
+    decor: &SceneDecor,
     log_time_ns: u64,
 ) -> SceneUpdate {
+    let fibres = &decor.fibres;
     let stamp = timestamp(log_time_ns);
     let mut spheres = Vec::with_capacity(frame.ids.len());
     let mut cylinders = Vec::new();
@@ -108,7 +182,15 @@ pub(crate) fn scene_update(
             size: Some(vec3(DVec3::splat(d))),
             color: col,
         };
-        if h == 0.0 {
+        let semi = decor.semi_axes.get(i).copied().unwrap_or(DVec3::ZERO);
+        if semi != DVec3::ZERO {
+            // a superquadric, drawn as the ellipsoid of its semi-axes
+            spheres.push(SpherePrimitive {
+                pose: pose(c, q),
+                size: Some(vec3(2.0 * semi)),
+                color: col,
+            });
+        } else if h == 0.0 {
             spheres.push(sphere(c));
         } else {
             // Foxglove cylinders have their axis along local z; the orientation maps body z
@@ -158,6 +240,9 @@ pub(crate) fn scene_update(
     // an unbounded run (the brownian pipeline) records zero edges: no outline
     if frame.box_edges != DVec3::ZERO {
         entities.push(outline);
+    }
+    if let Some(w) = decor.walls {
+        entities.push(wall_entity(w, frame.box_edges, entity(WALLS_ENTITY)));
     }
     if !fibres.is_empty() {
         entities.push(SceneEntity {

@@ -363,13 +363,13 @@ fn record_scene_geometry_of_spheres_capsules_and_box() {
         status_json: "{}".into(),
     };
     let colours = [[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 0.5]];
-    let s = scene::scene_update(&frame, Some(&colours), &[], 4);
+    let s = scene::scene_update(&frame, Some(&colours), &Default::default(), 4);
     let unbounded = ParticleFrame {
         box_edges: DVec3::ZERO,
         ..frame.clone()
     };
     assert_eq!(
-        scene::scene_update(&unbounded, None, &[], 4).entities.len(),
+        scene::scene_update(&unbounded, None, &Default::default(), 4).entities.len(),
         1
     );
     let p = &s.entities[0];

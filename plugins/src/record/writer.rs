@@ -2,7 +2,9 @@
 
 use super::frame::FibreShape;
 use super::proto::{ParticleState, particle_count, state_schema};
-use super::scene::scene_update;
+use super::scene::{SceneDecor, scene_update};
+use glam::DVec3;
+use magsep_components::container::Walls;
 use super::{
     METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
     SUMMARY_METADATA_NAME,
@@ -60,8 +62,8 @@ pub struct RecordingWriter {
     last_log_time: Option<u64>,
     /// Reused message encoding buffer.
     buf: Vec<u8>,
-    /// Fibres drawn in every scene update.
-    fibres: Vec<FibreShape>,
+    /// Fibres, walls and particle shapes drawn in every scene update.
+    decor: SceneDecor,
 }
 
 impl RecordingWriter {
@@ -87,7 +89,7 @@ impl RecordingWriter {
             frames_written: 0,
             last_log_time: None,
             buf: Vec::new(),
-            fibres: Vec::new(),
+            decor: SceneDecor::default(),
         };
         let mut mcap = options
             .create(BufWriter::new(file))
@@ -177,7 +179,7 @@ impl RecordingWriter {
         self.write_message(self.state_channel, sequence, log_time)?;
 
         self.buf.clear();
-        scene_update(frame, colours, &self.fibres, log_time)
+        scene_update(frame, colours, &self.decor, log_time)
             .encode(&mut self.buf)
             .map_err(|e| RecordError::InvalidInput {
                 detail: format!("encoding /scene: {e}"),
@@ -192,7 +194,19 @@ impl RecordingWriter {
 
     /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
     pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
-        self.fibres = fibres;
+        self.decor.fibres = fibres;
+    }
+
+    /// Hard walls to draw (entity `walls`, sized from each frame's box edges) in every
+    /// following scene update.
+    pub fn set_walls(&mut self, walls: Option<Walls>) {
+        self.decor.walls = walls;
+    }
+
+    /// Superquadric semi-axes per particle (frame order; zero for spheres and rods): such
+    /// particles are drawn as ellipsoids of these semi-axes.
+    pub fn set_semi_axes(&mut self, semi_axes: Vec<DVec3>) {
+        self.decor.semi_axes = semi_axes;
     }
 
     /// Writes the metadata record [`SUMMARY_METADATA_NAME`] with key `summary` = `summary_json`

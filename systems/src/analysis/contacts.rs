@@ -37,7 +37,7 @@ pub fn contact_numbers(state: &PackingState) -> ContactNumbers {
     let mut per_particle_small = vec![0u64; state.len()];
     let mut max_overlap: f64 = 0.0;
     let d_min = 1e-8;
-    for (i, j, shift) in list.unique_pairs(state.edge) {
+    for (i, j, shift) in list.unique_pairs(state.edges) {
         let c = state.contact(i, j, shift);
         let gap = -c.overlap;
         max_overlap = max_overlap.max(c.overlap);

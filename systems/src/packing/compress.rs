@@ -1,8 +1,10 @@
 //! The compression driver (thesis 000, Alg. A): volume steps with revert and halving.
 //!
-//! Each step saves the last overlap-free state, removes a volume dV from the periodic cube by an
-//! affine scaling of all centres, and removes the overlaps within the attempt budget. On
-//! failure the saved state is restored and the step refined.
+//! Each step saves the last overlap-free state, removes a volume dV from the container by an
+//! affine scaling of all centres along the container's compressed axes (all three for the
+//! periodic cube and the closed box; z only for the cylinder, the wedge and the slab, whose
+//! walls keep their size: thesis L348-351, L361), and removes the overlaps within the attempt
+//! budget. On failure the saved state is restored and the step refined.
 //!
 //! * `Fixed` (the thesis): dV constant; after a failure dV /= 2; the run stops at the failure
 //!   that follows `step_halvings` halvings, i.e. a failure at dV_min = dV_0 / 2^h.
@@ -20,6 +22,8 @@ use super::moves::MoveRule;
 use super::neighbour::NeighbourList;
 use super::removal::{RemovalOutcome, remove_overlaps};
 use super::state::PackingState;
+use super::walls::compressed_axes;
+use glam::DVec3;
 
 /// Driver parameters in reduced units (lengths / D, volumes / D^3).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,12 +90,14 @@ pub fn initial_status(p: &DriverParams, state: &PackingState) -> PackingStatus {
         last_attempts: 0,
         packing_fraction: state.packing_fraction(),
         stopped: None,
+        contact_evaluations: 0,
+        contact_fallbacks: 0,
     }
 }
 
 /// The volume to remove in the next step / D^3.
 pub fn next_volume_step(p: &DriverParams, st: &PackingStatus, state: &PackingState) -> f64 {
-    let v_box = state.edge.powi(3);
+    let v_box = state.container_volume();
     let v_free = v_box - state.particle_volume();
     let dv = match p.step_rule {
         VolumeStepRule::Fixed => st.volume_step,
@@ -101,10 +107,14 @@ pub fn next_volume_step(p: &DriverParams, st: &PackingStatus, state: &PackingSta
     dv.min(0.5 * v_free)
 }
 
-/// Compress `state` by `dv` (/ D^3) and tell the list. Returns the linear scale factor.
-pub fn compress(state: &mut PackingState, list: &mut NeighbourList, dv: f64) -> f64 {
-    let v = state.edge.powi(3);
-    let s = ((v - dv) / v).cbrt();
+/// Compress `state` by `dv` (/ D^3) along the container's compressed axes and tell the list.
+/// Returns the scale factors per axis.
+pub fn compress(state: &mut PackingState, list: &mut NeighbourList, dv: f64) -> DVec3 {
+    let v = state.container_volume();
+    let axes = compressed_axes(state.walls);
+    let k = axes.iter().filter(|a| **a).count().max(1) as f64;
+    let f = ((v - dv) / v).powf(1.0 / k);
+    let s = DVec3::from_array(std::array::from_fn(|a| if axes[a] { f } else { 1.0 }));
     state.scale(s);
     list.note_compression(s);
     s
@@ -121,6 +131,8 @@ pub fn settle_step(
 ) {
     st.attempts += out.attempts;
     st.last_attempts = out.attempts;
+    st.contact_evaluations += out.contacts;
+    st.contact_fallbacks += out.fallbacks;
     let at_finest = dv <= p.min_volume_step() * (1.0 + 1e-9);
     if out.success {
         st.compression_steps += 1;

@@ -1,4 +1,5 @@
-//! Pair contacts of spheres and spherocylinders (a sphere is a rod of zero length).
+//! Pair contacts of spheres and spherocylinders (a sphere is a rod of zero length), and the
+//! adapter to the superquadric common-normal solver.
 //!
 //! The contact follows the common-normal principle (thesis 000, ch. 3): the closest points of
 //! the two axis segments give k (from i's axis point to j's), the overlap
@@ -6,9 +7,11 @@
 //! n = k / |k| (pointing into j), and i's contact point relative to its centre
 //! r_c = s u_i + R_i n.
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
+use super::state::{Body, BodyKind};
 use crate::geometry::segment_closest;
+use crate::geometry::superquadric::{self as sq, ContactOptions, Superquadric};
 
 /// Contact of particle i with (an image of) particle j.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,6 +26,30 @@ pub struct PairContact {
     pub s: f64,
     /// Position of j's closest axis point along its axis / D.
     pub t: f64,
+    /// i's contact point on its surface, relative to i's centre / D (lab frame).
+    pub rc_i: DVec3,
+    /// j's contact point on its surface, relative to j's centre / D (lab frame).
+    pub rc_j: DVec3,
+    /// The contact solver did not converge and this is its fallback estimate (superquadrics;
+    /// counted and reported, never dropped).
+    pub fallback: bool,
+}
+
+impl PairContact {
+    /// A contact with a flat wall: overlap (penetration depth), the wall's outward normal at
+    /// the deepest point, and the deepest point relative to the centre.
+    pub fn wall(overlap: f64, normal: DVec3, rc: DVec3) -> Self {
+        Self {
+            overlap,
+            normal,
+            k: DVec3::ZERO,
+            s: 0.0,
+            t: 0.0,
+            rc_i: rc,
+            rc_j: rc + overlap * normal,
+            fallback: false,
+        }
+    }
 }
 
 /// Contact between i (axis `u_i`, half length `h_i`, radius `r_i`) and j at relative
@@ -72,5 +99,52 @@ pub fn pair_contact(
         k: c.k,
         s: c.s,
         t: c.t,
+        rc_i: c.s * u_i + r_i * normal,
+        rc_j: c.t * u_j - r_j * normal,
+        fallback: false,
+    }
+}
+
+/// Contact of two bodies of which at least one is a superquadric (a sphere is treated as the
+/// superquadric with exponents 2). Rods of nonzero length cannot meet superquadrics (scene
+/// validation rejects such mixtures); they are approximated by their circumscribed
+/// spheroid and flagged as a fallback.
+pub fn superquadric_contact(
+    a: &Body,
+    xa: DVec3,
+    qa: DQuat,
+    b: &Body,
+    xb: DVec3,
+    qb: DQuat,
+) -> PairContact {
+    let sa = as_superquadric(a);
+    let sb = as_superquadric(b);
+    let opts = ContactOptions {
+        gap_cutoff: 0.05,
+        ..ContactOptions::default()
+    };
+    let r = sq::contact(&sa.0, xa, qa, &sb.0, xb, qb, &opts, None);
+    PairContact {
+        overlap: r.overlap,
+        normal: r.normal,
+        k: DVec3::ZERO,
+        s: 0.0,
+        t: 0.0,
+        rc_i: r.rc_a,
+        rc_j: r.rc_b,
+        fallback: sa.1 || sb.1 || r.is_fallback(),
+    }
+}
+
+fn as_superquadric(b: &Body) -> (Superquadric, bool) {
+    match b.kind {
+        BodyKind::Superquadric(s) => (s, false),
+        BodyKind::Rod => (
+            Superquadric {
+                semi_axes: DVec3::new(b.radius, b.radius, b.radius + b.half_length),
+                exponents: DVec3::splat(2.0),
+            },
+            b.half_length > 0.0,
+        ),
     }
 }

@@ -11,8 +11,9 @@
 //! tolerance, revert and halving are unchanged; one FIRE iteration counts as N attempts.
 //!
 //! Forces: the contact (i, j) with overlap delta and unit normal n (from i towards j) pushes i
-//! with -delta n at its contact point s u_i + (R_i - delta/2) n (the middle of the overlap
-//! lens), and j with +delta n at t u_j - (R_j - delta/2) n. Masses are the reduced volumes;
+//! with -delta n at the middle of the overlap lens, r_c,i - delta/2 n (for rods
+//! s u_i + (R_i - delta/2) n), and j with +delta n at r_c,j + delta/2 n. A wall contact
+//! (virtual particle or deepest point) pushes i alone. Masses are the reduced volumes;
 //! rotations use the largest principal moment (isotropic rotor), which changes the path of the
 //! minimiser but not its minima. Parameters are Bitzek et al.'s (N_min 5, f_inc 1.1,
 //! f_dec 0.5, alpha_0 0.1, f_alpha 0.99) with dt_0 = 0.1, dt_max = 1 (reduced units: D = 1,
@@ -21,8 +22,8 @@
 use glam::{DQuat, DVec3};
 
 use super::neighbour::NeighbourList;
-use super::removal::RemovalOutcome;
-use super::state::PackingState;
+use super::removal::{RemovalOutcome, turn_bound};
+use super::state::{BodyKind, PackingState};
 
 /// Iterations over which a stagnating energy ends the minimisation as failed.
 pub const STAGNATION_WINDOW: u64 = 2000;
@@ -45,19 +46,22 @@ impl Default for FireParams {
     }
 }
 
-/// Forces and torques of the overlap energy; returns (max overlap, energy).
+/// Forces and torques of the overlap energy (pairs and walls); returns (max overlap, energy,
+/// contact-solver fallbacks).
 pub fn overlap_forces(
     state: &PackingState,
     list: &NeighbourList,
     force: &mut [DVec3],
     torque: &mut [DVec3],
-) -> (f64, f64) {
+) -> (f64, f64, u64) {
     force.iter_mut().for_each(|f| *f = DVec3::ZERO);
     torque.iter_mut().for_each(|t| *t = DVec3::ZERO);
     let mut max_overlap: f64 = 0.0;
     let mut energy = 0.0;
-    for (i, j, shift) in list.unique_pairs(state.edge) {
+    let mut fallbacks = 0;
+    for (i, j, shift) in list.unique_pairs(state.edges) {
         let c = state.contact(i, j, shift);
+        fallbacks += c.fallback as u64;
         if c.overlap <= 0.0 {
             continue;
         }
@@ -66,13 +70,24 @@ pub fn overlap_forces(
         let f = c.overlap * c.normal;
         force[i] -= f;
         force[j] += f;
-        let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
-        let ri = c.s * state.axis(i) + (bi.radius - 0.5 * c.overlap) * c.normal;
-        let rj = c.t * state.axis(j) - (bj.radius - 0.5 * c.overlap) * c.normal;
+        let ri = c.rc_i - 0.5 * c.overlap * c.normal;
+        let rj = c.rc_j + 0.5 * c.overlap * c.normal;
         torque[i] += ri.cross(-f);
         torque[j] += rj.cross(f);
     }
-    (max_overlap, energy)
+    let mut walls = Vec::new();
+    for i in 0..state.len() {
+        walls.clear();
+        state.wall_contacts(i, 0.0, &mut walls);
+        for c in walls.iter().filter(|c| c.overlap > 0.0) {
+            max_overlap = max_overlap.max(c.overlap);
+            energy += 0.5 * c.overlap * c.overlap;
+            let f = c.overlap * c.normal;
+            force[i] -= f;
+            torque[i] += (c.rc_i - 0.5 * c.overlap * c.normal).cross(-f);
+        }
+    }
+    (max_overlap, energy, fallbacks)
 }
 
 /// Minimise the overlap energy until no overlap exceeds `tol`, with at most `max_iterations`
@@ -95,44 +110,48 @@ pub fn remove_overlaps_fire(
         .iter()
         .map(|b| b.inertia.max_element())
         .collect();
-    let rotates: Vec<bool> = state.bodies.iter().map(|b| b.half_length > 0.0).collect();
+    let rotates: Vec<bool> = state.bodies.iter().map(|b| b.rotates()).collect();
+    let axisymmetric: Vec<bool> = state
+        .bodies
+        .iter()
+        .map(|b| matches!(b.kind, BodyKind::Rod))
+        .collect();
+    let (mut contacts, mut fallbacks) = (0u64, 0u64);
+    let pairs_per_eval = |list: &NeighbourList| list.len() as u64 / 2;
     let (mut dt, mut alpha, mut since_negative) = (params.dt, 0.1, 0u64);
     let mut it = 0;
     let mut window_energy = f64::INFINITY;
     loop {
         list.ensure(state);
-        let (max_overlap, energy) = overlap_forces(state, list, &mut f, &mut t);
+        let (max_overlap, energy, fb) = overlap_forces(state, list, &mut f, &mut t);
+        contacts += pairs_per_eval(list);
+        fallbacks += fb;
+        let outcome = |success: bool, it: u64| RemovalOutcome {
+            success,
+            attempts: it * n as u64,
+            sweeps: it,
+            contacts,
+            fallbacks,
+        };
         if max_overlap <= tol {
-            return RemovalOutcome {
-                success: true,
-                attempts: it * n as u64,
-                sweeps: it,
-            };
+            return outcome(true, it);
         }
         // A jammed configuration relaxes to a minimum with finite energy: when the energy has
         // fallen by less than 2 % over the last STAGNATION_WINDOW iterations, give up early.
         if it % STAGNATION_WINDOW == 0 {
             if it > 0 && energy > 0.98 * window_energy {
-                return RemovalOutcome {
-                    success: false,
-                    attempts: it * n as u64,
-                    sweeps: it,
-                };
+                return outcome(false, it);
             }
             window_energy = energy;
         }
         if it >= max_iterations {
-            return RemovalOutcome {
-                success: false,
-                attempts: it * n as u64,
-                sweeps: it,
-            };
+            return outcome(false, it);
         }
         it += 1;
         for i in 0..n {
             if !rotates[i] {
                 t[i] = DVec3::ZERO;
-            } else {
+            } else if axisymmetric[i] {
                 let a = state.axis(i);
                 let along = t[i].dot(a);
                 t[i] -= along * a; // spin about the axis moves nothing
@@ -171,16 +190,15 @@ pub fn remove_overlaps_fire(
             v[i] += dt * f[i] / mass[i];
             w[i] += dt * t[i] / rot_inertia[i];
             let dx = dt * v[i];
-            let old_axis = state.axis(i);
             state.positions[i] += dx;
             let angle = w[i].length() * dt;
+            let mut turn = 0.0;
             if angle > 0.0 {
-                state.orientations[i] = (DQuat::from_axis_angle(w[i] / w[i].length(), angle)
-                    * state.orientations[i])
-                    .normalize();
+                let r = DQuat::from_axis_angle(w[i] / w[i].length(), angle);
+                state.orientations[i] = (r * state.orientations[i]).normalize();
+                turn = turn_bound(&state.bodies[i], r);
             }
-            let du = state.axis(i) - old_axis;
-            list.note_move(i, dx, du, state.bodies[i].half_length);
+            list.note_move(i, dx, turn);
         }
     }
 }

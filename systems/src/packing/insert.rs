@@ -1,6 +1,7 @@
 //! Random start configuration: random sequential insertion without overlap.
 //!
-//! Each particle, in id order, draws trial centres uniformly in the periodic cube and
+//! Each particle, in id order, draws trial centres uniformly in the container (rejecting
+//! those where it would cross a wall) and
 //! orientations uniformly on the sphere (normalised Gaussian quaternion) from its own stream
 //! until it overlaps no earlier particle (thesis: "care is taken to ensure no initial
 //! particle-particle overlaps exist", L259).
@@ -10,8 +11,9 @@ use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-use super::contact::pair_contact;
-use super::state::{Body, PackingState};
+use super::neighbour::CellGrid;
+use super::state::{Body, PackingState, body_contact};
+use super::walls::{self, WallKind};
 
 /// Why insertion failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -39,34 +41,45 @@ pub fn random_orientation(rng: &mut Xoshiro256PlusPlus) -> DQuat {
     }
 }
 
-/// Place `bodies` in a cube of edge `edge` (reduced units) without overlaps. `rngs[i]` is
-/// particle i's stream; they are advanced.
+/// Place `bodies` without overlaps in the (empty) container of `container` (reduced units),
+/// uniformly in its volume and clear of its walls. `rngs[i]` is particle i's stream; they are
+/// advanced.
+///
+/// # Errors
+/// [`InsertionError`] when a particle finds no free place in 10^6 trials.
 pub fn random_insertion(
     bodies: &[Body],
-    edge: f64,
+    container: PackingState,
     rngs: &mut [Xoshiro256PlusPlus],
 ) -> Result<PackingState, InsertionError> {
     let n = bodies.len();
-    let mut state = PackingState {
-        edge,
-        positions: Vec::with_capacity(n),
-        orientations: Vec::with_capacity(n),
-        bodies: Vec::with_capacity(n),
-    };
+    let mut state = container;
+    state.positions = Vec::with_capacity(n);
+    state.orientations = Vec::with_capacity(n);
+    state.bodies = Vec::with_capacity(n);
+    let edges = state.edges;
+    let periodic = state.periodic();
     let max_b = bodies
         .iter()
         .map(|b| b.bounding_radius())
         .fold(0.0, f64::max);
     let cutoff = 2.0 * max_b;
-    let ncell = ((edge / cutoff).floor() as i64).max(1);
-    let use_cells = ncell >= 3;
-    let nc = ncell as usize;
-    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); if use_cells { nc * nc * nc } else { 1 }];
-    let cell_of = |p: DVec3| -> [i64; 3] {
-        let f = |c: f64| (((c / edge) * ncell as f64).floor() as i64).clamp(0, ncell - 1);
-        [f(p.x), f(p.y), f(p.z)]
+    let grid = CellGrid::new(edges, periodic, cutoff);
+    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); grid.map(|g| g.len()).unwrap_or(1)];
+    let cell_index = |g: &CellGrid, p: DVec3| {
+        let c = g.coords(p);
+        ((c[0] as usize) * g.cells[1] + c[1] as usize) * g.cells[2] + c[2] as usize
     };
-    let k_img = (cutoff / edge).ceil() as i64;
+    let k_img: [i64; 3] =
+        std::array::from_fn(|a| if periodic[a] { (cutoff / edges[a]).ceil() as i64 } else { 0 });
+    let images = || {
+        (-k_img[0]..=k_img[0]).flat_map(move |a| {
+            (-k_img[1]..=k_img[1]).flat_map(move |b| {
+                (-k_img[2]..=k_img[2])
+                    .map(move |c| DVec3::new(a as f64, b as f64, c as f64) * edges)
+            })
+        })
+    };
     let max_trials = 1_000_000u64;
     for (i, body) in bodies.iter().enumerate() {
         let rng = &mut rngs[i];
@@ -77,104 +90,51 @@ pub fn random_insertion(
                 return Err(InsertionError {
                     index: i,
                     trials,
-                    packing_fraction: bodies.iter().map(|b| b.volume).sum::<f64>() / edge.powi(3),
+                    packing_fraction: bodies.iter().map(|b| b.volume).sum::<f64>()
+                        / state.container_volume(),
                 });
             }
             let p = DVec3::new(
                 rng.random::<f64>(),
                 rng.random::<f64>(),
                 rng.random::<f64>(),
-            ) * edge;
+            ) * edges;
             let q = random_orientation(rng);
-            let u = q * DVec3::Z;
+            if state.walls != WallKind::Periodic {
+                let support = |d: DVec3| body.support(q, d);
+                if walls::penetration_depth(state.walls, edges, p, &support) > -1e-9 {
+                    continue;
+                }
+            }
             let overlaps = |j: usize, shift: DVec3| {
                 let bj = &state.bodies[j];
-                let r = state.positions[j] + shift - p;
+                let xj = state.positions[j] + shift;
                 let reach = body.bounding_radius() + bj.bounding_radius();
-                r.length_squared() < reach * reach
-                    && pair_contact(
-                        u,
-                        body.half_length,
-                        body.radius,
-                        r,
-                        state.axis(j),
-                        bj.half_length,
-                        bj.radius,
-                    )
-                    .overlap
-                        > 0.0
+                (xj - p).length_squared() < reach * reach
+                    && body_contact(body, p, q, bj, xj, state.orientations[j]).overlap > 0.0
             };
             let mut hit = false;
-            if use_cells {
-                let c = cell_of(p);
-                'outer: for dx in -1..=1 {
-                    for dy in -1..=1 {
-                        for dz in -1..=1 {
-                            let mut shift = DVec3::ZERO;
-                            let mut idx = 0usize;
-                            for (a, d) in [dx, dy, dz].into_iter().enumerate() {
-                                let raw = c[a] + d;
-                                let w = raw.rem_euclid(ncell);
-                                shift[a] = ((raw - w) / ncell) as f64 * edge;
-                                idx = idx * nc + w as usize;
-                            }
-                            for &j in &cells[idx] {
-                                if overlaps(j as usize, shift) {
-                                    hit = true;
-                                    break 'outer;
-                                }
-                            }
-                        }
+            if let Some(g) = &grid {
+                g.for_each_neighbour_cell(p, |cell, shift| {
+                    if !hit {
+                        hit = cells[cell].iter().any(|&j| overlaps(j as usize, shift));
                     }
-                }
+                });
             } else {
-                'brute: for j in 0..state.len() {
-                    for a in -k_img..=k_img {
-                        for b in -k_img..=k_img {
-                            for cc in -k_img..=k_img {
-                                if overlaps(j, DVec3::new(a as f64, b as f64, cc as f64) * edge) {
-                                    hit = true;
-                                    break 'brute;
-                                }
-                            }
-                        }
-                    }
-                }
-                // a rod longer than the box may overlap its own images
-                if !hit && body.bounding_radius() * 2.0 > edge {
-                    for a in -k_img..=k_img {
-                        for b in -k_img..=k_img {
-                            for cc in -k_img..=k_img {
-                                if (a, b, cc) == (0, 0, 0) {
-                                    continue;
-                                }
-                                let r = DVec3::new(a as f64, b as f64, cc as f64) * edge;
-                                if pair_contact(
-                                    u,
-                                    body.half_length,
-                                    body.radius,
-                                    r,
-                                    u,
-                                    body.half_length,
-                                    body.radius,
-                                )
-                                .overlap
-                                    > 0.0
-                                {
-                                    hit = true;
-                                }
-                            }
-                        }
-                    }
+                hit = (0..state.len()).any(|j| images().any(|shift| overlaps(j, shift)));
+                // a particle longer than the box may overlap its own images
+                if !hit && body.bounding_radius() * 2.0 > edges.min_element() {
+                    hit = images().any(|shift| {
+                        shift != DVec3::ZERO
+                            && shift.length() < 2.0 * body.bounding_radius()
+                            && body_contact(body, p, q, body, p + shift, q).overlap > 0.0
+                    });
                 }
             }
             if !hit {
-                if use_cells {
-                    let c = cell_of(p);
-                    cells[((c[0] as usize) * nc + c[1] as usize) * nc + c[2] as usize]
-                        .push(i as u32);
-                } else {
-                    cells[0].push(i as u32);
+                match &grid {
+                    Some(g) => cells[cell_index(g, p)].push(i as u32),
+                    None => cells[0].push(i as u32),
                 }
                 state.positions.push(p);
                 state.orientations.push(q);

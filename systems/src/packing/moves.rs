@@ -28,7 +28,8 @@ use glam::{DMat3, DQuat, DVec3};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::state::Body;
+use super::contact::PairContact;
+use super::state::{Body, BodyKind};
 
 /// One overlapping contact of the moving particle, in the form the move rules need.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +42,20 @@ pub struct MoveContact {
     pub k: DVec3,
     /// Position of i's closest axis point along its axis / D.
     pub s: f64,
+    /// i's contact point relative to its centre / D (lab frame).
+    pub rc: DVec3,
+}
+
+impl From<&PairContact> for MoveContact {
+    fn from(c: &PairContact) -> Self {
+        Self {
+            overlap: c.overlap,
+            normal: c.normal,
+            k: c.k,
+            s: c.s,
+            rc: c.rc_i,
+        }
+    }
 }
 
 /// Which rule moves an overlapping particle.
@@ -106,10 +121,8 @@ pub fn revised_velocities(
     let mut f = DVec3::ZERO;
     let mut t = DVec3::ZERO;
     for c in cs {
-        let axis = orientation * DVec3::Z;
-        let rc = c.s * axis + body.radius * c.normal;
         f += c.normal;
-        t += c.normal.cross(rc);
+        t += c.normal.cross(c.rc);
     }
     let m = body.volume;
     let rot = DMat3::from_quat(orientation);
@@ -141,7 +154,7 @@ pub fn overlap_removal_move(
         | MoveRule::RevisedRandomRotation { dt }
         | MoveRule::RevisedRandomBoth { dt } => {
             let (mut v, mut w) = revised_velocities(body, orientation, cs)?;
-            let axisymmetric_rod = body.half_length > 0.0;
+            let axisymmetric_rod = matches!(body.kind, BodyKind::Rod) && body.half_length > 0.0;
             if matches!(
                 rule,
                 MoveRule::RevisedRandomRotation { .. } | MoveRule::RevisedRandomBoth { .. }
@@ -239,6 +252,7 @@ mod tests {
             normal: n,
             k: n * 0.95,
             s: 1.3,
+            rc: 1.3 * (q * DVec3::Z) + 0.5 * n,
         };
         let (v, w) = revised_velocities(&body, q, &[c]).unwrap();
         // kinetic-energy constraint c = 1 (eq. 3.4) to 1e-12
@@ -266,6 +280,7 @@ mod tests {
             normal: DVec3::X,
             k,
             s: 0.0,
+            rc: 0.5 * DVec3::X,
         };
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
         let d = overlap_removal_move(

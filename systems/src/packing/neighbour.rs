@@ -13,7 +13,7 @@
 
 use glam::DVec3;
 
-use super::state::PackingState;
+use super::state::{BodyKind, PackingState};
 use crate::geometry::segment_closest;
 
 /// One neighbour entry: particle `j` in periodic image `image` (its centre is
@@ -27,20 +27,119 @@ pub struct Neighbour {
 }
 
 impl Neighbour {
-    /// The image shift for a box of edge `edge`.
+    /// The image shift for a box of edges `edges`.
     #[inline]
-    pub fn shift(&self, edge: f64) -> DVec3 {
+    pub fn shift(&self, edges: DVec3) -> DVec3 {
         DVec3::new(
             self.image[0] as f64,
             self.image[1] as f64,
             self.image[2] as f64,
-        ) * edge
+        ) * edges
     }
 }
 
-fn image_of(shift: DVec3, edge: f64) -> [i16; 3] {
-    let r = (shift / edge).round();
+fn image_of(shift: DVec3, edges: DVec3) -> [i16; 3] {
+    let r = (shift / edges).round();
     [r.x as i16, r.y as i16, r.z as i16]
+}
+
+/// A cell grid over the box `[0, edges]` with cells no smaller than a cut-off, periodic along
+/// the flagged axes (where at least three cells fit) and clamped along walled axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellGrid {
+    /// Box edges / D.
+    pub edges: DVec3,
+    /// Periodic axes.
+    pub periodic: [bool; 3],
+    /// Cells per axis.
+    pub cells: [usize; 3],
+}
+
+impl CellGrid {
+    /// The grid for `cutoff`, or None when a periodic axis holds fewer than three cut-offs
+    /// (then every image must be searched).
+    pub fn new(edges: DVec3, periodic: [bool; 3], cutoff: f64) -> Option<Self> {
+        let mut cells = [1usize; 3];
+        for a in 0..3 {
+            let c = (edges[a] / cutoff).floor();
+            if periodic[a] && c < 3.0 {
+                return None;
+            }
+            cells[a] = (c.max(1.0) as usize).min(1 << 10);
+        }
+        Some(Self {
+            edges,
+            periodic,
+            cells,
+        })
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.cells[0] * self.cells[1] * self.cells[2]
+    }
+
+    /// Whether the grid has no cells (never).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Cell coordinates of `p` (clamped into the grid).
+    #[inline]
+    pub fn coords(&self, p: DVec3) -> [i64; 3] {
+        std::array::from_fn(|a| {
+            let n = self.cells[a] as i64;
+            (((p[a] / self.edges[a]) * n as f64).floor() as i64).clamp(0, n - 1)
+        })
+    }
+
+    #[inline]
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[0] * self.cells[1] + c[1]) * self.cells[2] + c[2]
+    }
+
+    /// Linked cell lists (head per cell, next per particle) of `positions`.
+    pub fn bin(&self, positions: &[DVec3]) -> (Vec<u32>, Vec<u32>) {
+        let mut head = vec![u32::MAX; self.len()];
+        let mut next = vec![u32::MAX; positions.len()];
+        for (i, p) in positions.iter().enumerate().rev() {
+            let c = self.coords(*p).map(|x| x as usize);
+            let k = self.index(c);
+            next[i] = head[k];
+            head[k] = i as u32;
+        }
+        (head, next)
+    }
+
+    /// Call `f(cell index, image shift)` for the cell of `p` and its neighbour cells (each
+    /// once; periodic wrap with the shift that brings the cell next to `p`).
+    pub fn for_each_neighbour_cell(&self, p: DVec3, mut f: impl FnMut(usize, DVec3)) {
+        let c = self.coords(p);
+        let range = |a: usize| -> std::ops::RangeInclusive<i64> {
+            let n = self.cells[a] as i64;
+            if self.periodic[a] {
+                -1..=1
+            } else {
+                (-1i64).max(-c[a])..=1i64.min(n - 1 - c[a])
+            }
+        };
+        for dx in range(0) {
+            for dy in range(1) {
+                for dz in range(2) {
+                    let mut shift = DVec3::ZERO;
+                    let mut cj = [0usize; 3];
+                    for (a, d) in [dx, dy, dz].into_iter().enumerate() {
+                        let n = self.cells[a] as i64;
+                        let raw = c[a] + d;
+                        let wrapped = raw.rem_euclid(n);
+                        shift[a] = ((raw - wrapped) / n) as f64 * self.edges[a];
+                        cj[a] = wrapped as usize;
+                    }
+                    f(self.index(cj), shift);
+                }
+            }
+        }
+    }
 }
 
 /// Symmetric Verlet list (each pair is stored for both particles) in CSR layout.
@@ -88,20 +187,21 @@ impl NeighbourList {
         self.entries.is_empty()
     }
 
-    /// Record that particle `i` moved by `dx` and its axis turned by `du` (half length `h`).
+    /// Record that particle `i` moved by `dx` and turned so that no surface point moved more
+    /// than `turn` relative to the centre (a rod: h |du|; any body: bounding radius x angle).
     #[inline]
-    pub fn note_move(&mut self, i: usize, dx: DVec3, du: DVec3, h: f64) {
+    pub fn note_move(&mut self, i: usize, dx: DVec3, turn: f64) {
         if let Some(m) = self.moved.get_mut(i) {
-            *m += dx.length() + h * du.length();
+            *m += dx.length() + turn;
             if *m > self.max_moved {
                 self.max_moved = *m;
             }
         }
     }
 
-    /// Record an affine compression of all centres by factor `s` < 1.
-    pub fn note_compression(&mut self, s: f64) {
-        self.compressed += (1.0 - s).abs() * self.centre_range;
+    /// Record an affine compression of all centres by factors `s` <= 1 per axis.
+    pub fn note_compression(&mut self, s: DVec3) {
+        self.compressed += (DVec3::ONE - s).abs().max_element() * self.centre_range;
     }
 
     /// Whether the list must be rebuilt before use.
@@ -149,65 +249,48 @@ impl NeighbourList {
             if r.length_squared() >= reach * reach {
                 return;
             }
-            let c = segment_closest(axes[i], bi.half_length, r, axes[j], bj.half_length);
-            let lim = bi.radius + bj.radius + self.skin;
-            if c.k.length_squared() < lim * lim {
-                pairs.push((i as u32, j as u32, shift));
-            }
-        };
-        let l = state.edge;
-        let ncell = (l / cutoff).floor() as i64;
-        if ncell >= 3 {
-            let nc = ncell as usize;
-            let cell_of = |p: DVec3| -> [usize; 3] {
-                let f = |c: f64| {
-                    (((c / l) * nc as f64).floor() as i64).clamp(0, nc as i64 - 1) as usize
-                };
-                [f(p.x), f(p.y), f(p.z)]
-            };
-            let mut head = vec![u32::MAX; nc * nc * nc];
-            let mut next = vec![u32::MAX; n];
-            let idx = |c: [usize; 3]| (c[0] * nc + c[1]) * nc + c[2];
-            for i in (0..n).rev() {
-                let c = idx(cell_of(state.positions[i]));
-                next[i] = head[c];
-                head[c] = i as u32;
-            }
-            for i in 0..n {
-                let ci = cell_of(state.positions[i]);
-                for dx in -1i64..=1 {
-                    for dy in -1i64..=1 {
-                        for dz in -1i64..=1 {
-                            let mut shift = DVec3::ZERO;
-                            let mut cj = [0usize; 3];
-                            for (a, d) in [dx, dy, dz].into_iter().enumerate() {
-                                let raw = ci[a] as i64 + d;
-                                let wrapped = raw.rem_euclid(ncell);
-                                shift[a] = ((raw - wrapped) / ncell) as f64 * l;
-                                cj[a] = wrapped as usize;
-                            }
-                            let mut j = head[idx(cj)];
-                            while j != u32::MAX {
-                                if (j as usize) > i {
-                                    test(i, j as usize, shift, &mut pairs);
-                                }
-                                j = next[j as usize];
-                            }
-                        }
-                    }
+            if let (BodyKind::Rod, BodyKind::Rod) = (bi.kind, bj.kind) {
+                let c = segment_closest(axes[i], bi.half_length, r, axes[j], bj.half_length);
+                let lim = bi.radius + bj.radius + self.skin;
+                if c.k.length_squared() >= lim * lim {
+                    return;
                 }
             }
+            pairs.push((i as u32, j as u32, shift));
+        };
+        let grid = CellGrid::new(state.edges, state.periodic(), cutoff);
+        if let Some(grid) = grid {
+            let (head, next) = grid.bin(&state.positions);
+            for i in 0..n {
+                grid.for_each_neighbour_cell(state.positions[i], |cell, shift| {
+                    let mut j = head[cell];
+                    while j != u32::MAX {
+                        if (j as usize) > i {
+                            test(i, j as usize, shift, &mut pairs);
+                        }
+                        j = next[j as usize];
+                    }
+                });
+            }
         } else {
-            let k = (cutoff / l).ceil() as i64;
+            let periodic = state.periodic();
+            let k: [i64; 3] = std::array::from_fn(|a| {
+                if periodic[a] {
+                    (cutoff / state.edges[a]).ceil() as i64
+                } else {
+                    0
+                }
+            });
             for i in 0..n {
                 for j in i..n {
-                    for a in -k..=k {
-                        for b in -k..=k {
-                            for c in -k..=k {
+                    for a in -k[0]..=k[0] {
+                        for b in -k[1]..=k[1] {
+                            for c in -k[2]..=k[2] {
                                 if i == j && (a, b, c) <= (0, 0, 0) {
                                     continue; // self: only one of each +n / -n pair
                                 }
-                                let shift = DVec3::new(a as f64, b as f64, c as f64) * l;
+                                let shift =
+                                    DVec3::new(a as f64, b as f64, c as f64) * state.edges;
                                 test(i, j, shift, &mut pairs);
                             }
                         }
@@ -234,7 +317,7 @@ impl NeighbourList {
             self.start[n] as usize
         ];
         for &(i, j, shift) in &pairs {
-            let image = image_of(shift, l);
+            let image = image_of(shift, state.edges);
             self.entries[fill[i as usize] as usize] = Neighbour { j, image };
             fill[i as usize] += 1;
             self.entries[fill[j as usize] as usize] = Neighbour {
@@ -251,13 +334,13 @@ impl NeighbourList {
     }
 
     /// Each unordered pair once: (i, j, shift) with i < j, or i == j for self-image pairs;
-    /// shifts for a box of edge `edge`.
-    pub fn unique_pairs(&self, edge: f64) -> impl Iterator<Item = (usize, usize, DVec3)> + '_ {
+    /// shifts for a box of edges `edges`.
+    pub fn unique_pairs(&self, edges: DVec3) -> impl Iterator<Item = (usize, usize, DVec3)> + '_ {
         (0..self.start.len().saturating_sub(1)).flat_map(move |i| {
             self.of(i).iter().filter_map(move |nb| {
                 let j = nb.j as usize;
                 let keep = j > i || (j == i && nb.image > [0, 0, 0]);
-                keep.then_some((i, j, nb.shift(edge)))
+                keep.then_some((i, j, nb.shift(edges)))
             })
         })
     }
@@ -274,7 +357,7 @@ mod tests {
     /// All pairs (i <= j, image) with a gap below `skin`, by brute force over images.
     fn brute(state: &PackingState, skin: f64) -> Vec<(usize, usize, [i16; 3])> {
         let n = state.len();
-        let l = state.edge;
+        let l = state.edges;
         let k = 3i16;
         let mut out = Vec::new();
         for i in 0..n {
@@ -301,8 +384,8 @@ mod tests {
 
     fn listed(state: &PackingState, list: &NeighbourList) -> Vec<(usize, usize, [i16; 3])> {
         let mut out: Vec<_> = list
-            .unique_pairs(state.edge)
-            .map(|(i, j, s)| (i, j, image_of(s, state.edge)))
+            .unique_pairs(state.edges)
+            .map(|(i, j, s)| (i, j, image_of(s, state.edges)))
             .collect();
         out.sort();
         out
@@ -312,7 +395,12 @@ mod tests {
         let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
         let v: f64 = bodies.iter().map(|b| b.volume).sum();
         let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
-        let mut state = random_insertion(&bodies, (v / phi).cbrt(), &mut rngs).unwrap();
+        let mut state = random_insertion(
+            &bodies,
+            PackingState::periodic_cube((v / phi).cbrt()),
+            &mut rngs,
+        )
+        .unwrap();
         let mut list = NeighbourList::new(0.3);
         list.build(&mut state);
         let want = brute(&state, 0.3);

@@ -7,14 +7,13 @@
 //! succeeds when no overlap above the tolerance remains, and fails when the attempt budget is
 //! spent first.
 
-use glam::DVec3;
+use glam::DQuat;
 use rand::Rng;
 use rand::seq::SliceRandom;
 
-use super::contact::pair_contact;
 use super::moves::{MoveContact, MoveRule, overlap_removal_move};
 use super::neighbour::NeighbourList;
-use super::state::PackingState;
+use super::state::{Body, BodyKind, PackingState};
 
 /// Result of [`remove_overlaps`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -25,9 +24,14 @@ pub struct RemovalOutcome {
     pub attempts: u64,
     /// Sweeps made.
     pub sweeps: u64,
+    /// Pair contacts evaluated in overlap scans.
+    pub contacts: u64,
+    /// Of which the contact solver fell back to its estimate (superquadrics).
+    pub fallbacks: u64,
 }
 
-/// Overlapping contacts (overlap > `tol`) of particle `i`, written into `out`.
+/// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls,
+/// written into `out`.
 pub fn overlapping_contacts(
     state: &PackingState,
     list: &NeighbourList,
@@ -36,55 +40,80 @@ pub fn overlapping_contacts(
     out: &mut Vec<MoveContact>,
 ) {
     out.clear();
-    let bi = &state.bodies[i];
-    let ui = state.axis(i);
-    let xi = state.positions[i];
     for nb in list.of(i) {
-        let j = nb.j as usize;
-        let bj = &state.bodies[j];
-        let r = state.positions[j] + nb.shift(state.edge) - xi;
-        let c = pair_contact(
-            ui,
-            bi.half_length,
-            bi.radius,
-            r,
-            state.axis(j),
-            bj.half_length,
-            bj.radius,
-        );
+        let c = state.contact(i, nb.j as usize, nb.shift(state.edges));
         if c.overlap > tol {
-            out.push(MoveContact {
-                overlap: c.overlap,
-                normal: c.normal,
-                k: c.k,
-                s: c.s,
-            });
+            out.push(MoveContact::from(&c));
         }
     }
+    let mut walls = Vec::new();
+    state.wall_contacts(i, -tol, &mut walls);
+    out.extend(walls.iter().map(MoveContact::from));
 }
 
-/// Total overlap (sum over unique pairs of max(overlap, 0)) and the flags of particles with an
-/// overlap above `tol`.
+/// Result of [`overlap_scan`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct OverlapScan {
+    /// Sum over pairs and wall contacts of max(overlap, 0) / D.
+    pub total: f64,
+    /// Largest overlap / D.
+    pub max: f64,
+    /// Pair contacts evaluated.
+    pub contacts: u64,
+    /// Of which the contact solver fell back to its estimate (superquadrics).
+    pub fallbacks: u64,
+}
+
+/// Total overlap (pairs and walls) and the flags of particles with an overlap above `tol`.
 pub fn overlap_scan(
     state: &PackingState,
     list: &NeighbourList,
     tol: f64,
     flags: &mut Vec<bool>,
-) -> f64 {
+) -> OverlapScan {
     flags.clear();
     flags.resize(state.len(), false);
-    let mut total = 0.0;
-    for (i, j, shift) in list.unique_pairs(state.edge) {
+    let mut scan = OverlapScan::default();
+    for (i, j, shift) in list.unique_pairs(state.edges) {
         let c = state.contact(i, j, shift);
+        scan.contacts += 1;
+        scan.fallbacks += c.fallback as u64;
         if c.overlap > 0.0 {
-            total += c.overlap;
+            scan.total += c.overlap;
+            scan.max = scan.max.max(c.overlap);
         }
         if c.overlap > tol {
             flags[i] = true;
             flags[j] = true;
         }
     }
-    total
+    let mut walls = Vec::new();
+    for (i, flag) in flags.iter_mut().enumerate() {
+        walls.clear();
+        state.wall_contacts(i, 0.0, &mut walls);
+        for c in &walls {
+            scan.total += c.overlap.max(0.0);
+            scan.max = scan.max.max(c.overlap);
+            if c.overlap > tol {
+                *flag = true;
+            }
+        }
+    }
+    scan
+}
+
+/// How far a rotation `r` can move a surface point of `body` relative to its centre / D.
+#[inline]
+pub fn turn_bound(body: &Body, r: DQuat) -> f64 {
+    if !body.rotates() {
+        return 0.0;
+    }
+    let angle = 2.0 * r.w.abs().min(1.0).acos();
+    let reach = match body.kind {
+        BodyKind::Rod => body.half_length,
+        BodyKind::Superquadric(_) => body.bounding_radius(),
+    };
+    reach * 2.0 * (0.5 * angle).sin()
 }
 
 /// Move particle `i` once with `rule` if it overlaps anything above `tol`. Returns whether it
@@ -103,11 +132,9 @@ pub fn move_particle(
     let Some(d) = overlap_removal_move(rule, &body, state.orientations[i], scratch, rng) else {
         return false;
     };
-    let old_axis = state.axis(i);
     state.positions[i] += d.dx;
     state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
-    let du: DVec3 = state.axis(i) - old_axis;
-    list.note_move(i, d.dx, du, body.half_length);
+    list.note_move(i, d.dx, turn_bound(&body, d.rotation));
     true
 }
 
@@ -125,9 +152,12 @@ pub fn remove_overlaps(
     let mut flags = Vec::new();
     let mut order = Vec::new();
     let mut scratch = Vec::new();
+    let (mut contacts, mut fallbacks) = (0, 0);
     loop {
         list.ensure(state);
-        overlap_scan(state, list, tol, &mut flags);
+        let scan = overlap_scan(state, list, tol, &mut flags);
+        contacts += scan.contacts;
+        fallbacks += scan.fallbacks;
         order.clear();
         order.extend(
             flags
@@ -141,6 +171,8 @@ pub fn remove_overlaps(
                 success: true,
                 attempts,
                 sweeps,
+                contacts,
+                fallbacks,
             };
         }
         if attempts >= budget {
@@ -148,6 +180,8 @@ pub fn remove_overlaps(
                 success: false,
                 attempts,
                 sweeps,
+                contacts,
+                fallbacks,
             };
         }
         order.shuffle(rng);
@@ -171,6 +205,8 @@ pub fn remove_overlaps(
                 success: false,
                 attempts: budget.max(attempts),
                 sweeps,
+                contacts,
+                fallbacks,
             };
         }
     }

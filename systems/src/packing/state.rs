@@ -2,22 +2,37 @@
 //!
 //! The MCM's revised step size depends on the unit system (spec packing.md 5.2: a move is at
 //! most delta_min * dt * sqrt(2c/m)), so the kernels work in the thesis's units: lengths in
-//! units of a reference diameter D (the smallest particle diameter of the scene), density 1
-//! (mass = reduced volume), c = 1. [`PackingState::from_si`] and [`PackingState::to_si`]
-//! convert.
+//! units of a reference diameter D (the smallest particle diameter of the scene, twice the
+//! smallest semi-axis for superquadrics), density 1 (mass = reduced volume), c = 1.
+//! [`PackingState::from_si`] and [`PackingState::to_si`] convert.
+//!
+//! The container is the box `[0, edges]` with the wall geometry of [`WallKind`]: periodic
+//! along the axes the walls leave open, hard walls (virtual particles, [`super::walls`])
+//! elsewhere.
 
 use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
-use crate::geometry::{inertia_body_unit_density, volume};
-use crate::packing::contact::{PairContact, pair_contact};
+use super::walls::{self, WallContact, WallKind};
+use crate::geometry::superquadric::Superquadric;
+use crate::geometry::{bounding_radius, inertia_body_unit_density, volume};
+use crate::packing::contact::{PairContact, pair_contact, superquadric_contact};
+
+/// Geometry class of a body: decides the contact routine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BodyKind {
+    /// A sphere or spherocylinder (`radius`, `half_length`): segment distance.
+    Rod,
+    /// A superquadric in reduced units: common-normal Newton-Raphson.
+    Superquadric(Superquadric),
+}
 
 /// Geometry and inertia of one particle, reduced units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Body {
-    /// Radius R / D.
+    /// Radius R / D (smallest semi-axis for a superquadric).
     pub radius: f64,
-    /// Half length of the axis segment / D (0 for spheres).
+    /// Half length of the axis segment / D (0 for spheres and superquadrics).
     pub half_length: f64,
     /// Volume / D^3 (= mass at density 1).
     pub volume: f64,
@@ -25,6 +40,10 @@ pub struct Body {
     pub inertia: DVec3,
     /// I_xy / m of eq. 2.3 (the thesis's xi for the original scheme) / D^2.
     pub xi_default: f64,
+    /// Radius of the bounding sphere about the centre / D.
+    pub bounding: f64,
+    /// Contact class.
+    pub kind: BodyKind,
 }
 
 impl Body {
@@ -39,29 +58,75 @@ impl Body {
                 radius: radius / d,
                 half_length: half_length / d,
             },
+            Shape::Superquadric {
+                semi_axes,
+                exponents,
+            } => Shape::Superquadric {
+                semi_axes: semi_axes / d,
+                exponents,
+            },
         };
         let v = volume(&scaled);
         let inertia = inertia_body_unit_density(&scaled);
+        let kind = match scaled {
+            Shape::Superquadric {
+                semi_axes,
+                exponents,
+            } => BodyKind::Superquadric(Superquadric {
+                semi_axes,
+                exponents,
+            }),
+            _ => BodyKind::Rod,
+        };
         Self {
             radius: scaled.radius(),
             half_length: scaled.half_length(),
             volume: v,
             inertia,
             xi_default: inertia.x / v,
+            bounding: bounding_radius(&scaled),
+            kind,
         }
     }
 
     /// Radius of the bounding sphere / D.
+    #[inline]
     pub fn bounding_radius(&self) -> f64 {
-        self.radius + self.half_length
+        self.bounding
+    }
+
+    /// Whether rotations move the body's surface (false for spheres).
+    pub fn rotates(&self) -> bool {
+        match self.kind {
+            BodyKind::Rod => self.half_length > 0.0,
+            BodyKind::Superquadric(s) => {
+                s.exponents != DVec3::splat(2.0)
+                    || s.semi_axes.max_element() > s.semi_axes.min_element()
+            }
+        }
+    }
+
+    /// Farthest surface point in lab direction `dir` (unit), relative to the centre, for the
+    /// orientation `q`.
+    pub fn support(&self, q: DQuat, dir: DVec3) -> DVec3 {
+        match self.kind {
+            BodyKind::Rod => {
+                let u = q * DVec3::Z;
+                let end = if u.dot(dir) >= 0.0 { u } else { -u };
+                self.half_length * end + self.radius * dir
+            }
+            BodyKind::Superquadric(s) => q * s.support(q.inverse() * dir),
+        }
     }
 }
 
-/// Positions, orientations and bodies of all particles in a periodic cube, reduced units.
+/// Positions, orientations and bodies of all particles in a container, reduced units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PackingState {
-    /// Edge of the periodic cube / D; positions lie in [0, edge).
-    pub edge: f64,
+    /// Extent of the container's box / D; positions lie in `[0, edges)` along periodic axes.
+    pub edges: DVec3,
+    /// Wall geometry (periodic cube: [`WallKind::Periodic`]).
+    pub walls: WallKind,
     /// Centres / D.
     pub positions: Vec<DVec3>,
     /// Orientations (body z = rod axis).
@@ -71,26 +136,40 @@ pub struct PackingState {
 }
 
 impl PackingState {
-    /// Build from SI data; `d` is the reference diameter [m].
+    /// Build from SI data; `edges` [m] and `walls` (in reduced units) describe the container,
+    /// `d` is the reference diameter [m].
     pub fn from_si(
-        edge: f64,
+        edges: DVec3,
+        walls: WallKind,
         positions: &[DVec3],
         orientations: &[DQuat],
         shapes: &[Shape],
         d: f64,
     ) -> Self {
         Self {
-            edge: edge / d,
+            edges: edges / d,
+            walls,
             positions: positions.iter().map(|p| *p / d).collect(),
             orientations: orientations.to_vec(),
             bodies: shapes.iter().map(|s| Body::from_shape(s, d)).collect(),
         }
     }
 
-    /// Edge [m] and positions [m] for reference diameter `d`.
-    pub fn to_si(&self, d: f64) -> (f64, Vec<DVec3>) {
+    /// A periodic cube of edge `edge` (reduced units) with no particles.
+    pub fn periodic_cube(edge: f64) -> Self {
+        Self {
+            edges: DVec3::splat(edge),
+            walls: WallKind::Periodic,
+            positions: Vec::new(),
+            orientations: Vec::new(),
+            bodies: Vec::new(),
+        }
+    }
+
+    /// Edges [m] and positions [m] for reference diameter `d`.
+    pub fn to_si(&self, d: f64) -> (DVec3, Vec<DVec3>) {
         (
-            self.edge * d,
+            self.edges * d,
             self.positions.iter().map(|p| *p * d).collect(),
         )
     }
@@ -110,9 +189,20 @@ impl PackingState {
         self.bodies.iter().map(|b| b.volume).sum()
     }
 
-    /// Packing fraction.
+    /// Container volume / D^3.
+    pub fn container_volume(&self) -> f64 {
+        walls::container_volume(self.walls, self.edges)
+    }
+
+    /// Packing fraction (particle volume over container volume, spec eq. 3.1).
     pub fn packing_fraction(&self) -> f64 {
-        self.particle_volume() / self.edge.powi(3)
+        self.particle_volume() / self.container_volume()
+    }
+
+    /// Which axes are periodic.
+    #[inline]
+    pub fn periodic(&self) -> [bool; 3] {
+        walls::periodic_axes(self.walls)
     }
 
     /// Axis (body z in the lab frame) of particle `i`.
@@ -124,44 +214,121 @@ impl PackingState {
     /// Contact of particles `i` and `j`, with `j` seen through the periodic image `shift`.
     #[inline]
     pub fn contact(&self, i: usize, j: usize, shift: DVec3) -> PairContact {
-        let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
-        pair_contact(
-            self.axis(i),
-            bi.half_length,
-            bi.radius,
-            self.positions[j] + shift - self.positions[i],
-            self.axis(j),
-            bj.half_length,
-            bj.radius,
+        body_contact(
+            &self.bodies[i],
+            self.positions[i],
+            self.orientations[i],
+            &self.bodies[j],
+            self.positions[j] + shift,
+            self.orientations[j],
         )
     }
 
-    /// Wrap particle `i` into [0, edge).
-    #[inline]
-    pub fn wrap(&mut self, i: usize) {
-        let l = self.edge;
-        let p = &mut self.positions[i];
-        for c in [&mut p.x, &mut p.y, &mut p.z] {
-            *c -= l * (*c / l).floor();
-            if *c >= l {
-                *c = 0.0;
+    /// Wall contacts of particle `i` with overlap > `-margin` (virtual rods for spheres and
+    /// spherocylinders, the deepest-point rule for superquadrics), appended to `out`.
+    pub fn wall_contacts(&self, i: usize, margin: f64, out: &mut Vec<PairContact>) {
+        if self.walls == WallKind::Periodic {
+            return;
+        }
+        let b = &self.bodies[i];
+        let (x, q) = (self.positions[i], self.orientations[i]);
+        match b.kind {
+            BodyKind::Rod => {
+                let mut virt = Vec::new();
+                walls::virtual_rods(
+                    self.walls,
+                    self.edges,
+                    x,
+                    q * DVec3::Z,
+                    b.radius,
+                    b.half_length,
+                    &mut virt,
+                );
+                for v in &virt {
+                    let c = pair_contact(
+                        q * DVec3::Z,
+                        b.half_length,
+                        b.radius,
+                        v.centre - x,
+                        v.axis,
+                        v.half_length,
+                        v.radius,
+                    );
+                    if c.overlap > -margin {
+                        out.push(c);
+                    }
+                }
+            }
+            BodyKind::Superquadric(_) => {
+                let mut wc: Vec<WallContact> = Vec::new();
+                let support = |d: DVec3| b.support(q, d);
+                walls::convex_wall_contacts(self.walls, self.edges, x, &support, margin, &mut wc);
+                out.extend(wc.iter().map(|w| PairContact::wall(w.overlap, w.normal, w.rc)));
             }
         }
     }
 
-    /// Scale the box and all centres by `s` (affine compression; orientations unchanged).
-    /// Centres are not wrapped (images scale with them), see `NeighbourList::build`.
-    pub fn scale(&mut self, s: f64) {
-        self.edge *= s;
+    /// Largest wall penetration depth of particle `i` / D (<= 0: inside).
+    pub fn wall_penetration(&self, i: usize) -> f64 {
+        let b = &self.bodies[i];
+        let q = self.orientations[i];
+        let support = |d: DVec3| b.support(q, d);
+        walls::penetration_depth(self.walls, self.edges, self.positions[i], &support)
+    }
+
+    /// Wrap particle `i` into `[0, edges)` along the periodic axes.
+    #[inline]
+    pub fn wrap(&mut self, i: usize) {
+        let periodic = self.periodic();
+        let p = &mut self.positions[i];
+        for a in 0..3 {
+            if periodic[a] {
+                let l = self.edges[a];
+                p[a] -= l * (p[a] / l).floor();
+                if p[a] >= l {
+                    p[a] = 0.0;
+                }
+            }
+        }
+    }
+
+    /// Scale the box and all centres by `s` along each axis (affine compression;
+    /// orientations unchanged). Centres are not wrapped (images scale with them), see
+    /// `NeighbourList::build`.
+    pub fn scale(&mut self, s: DVec3) {
+        self.edges *= s;
         for p in &mut self.positions {
             *p *= s;
         }
     }
 
-    /// Wrap every centre into [0, edge).
+    /// Wrap every centre into the box along periodic axes.
     pub fn wrap_all(&mut self) {
         for i in 0..self.len() {
             self.wrap(i);
         }
+    }
+}
+
+/// Contact of body `a` at (`xa`, `qa`) with body `b` at (`xb`, `qb`).
+pub fn body_contact(
+    a: &Body,
+    xa: DVec3,
+    qa: DQuat,
+    b: &Body,
+    xb: DVec3,
+    qb: DQuat,
+) -> PairContact {
+    match (a.kind, b.kind) {
+        (BodyKind::Rod, BodyKind::Rod) => pair_contact(
+            qa * DVec3::Z,
+            a.half_length,
+            a.radius,
+            xb - xa,
+            qb * DVec3::Z,
+            b.half_length,
+            b.radius,
+        ),
+        _ => superquadric_contact(a, xa, qa, b, xb, qb),
     }
 }

@@ -16,6 +16,9 @@ use super::compress::{DriverParams, compress, next_volume_step, settle_step};
 use super::neighbour::NeighbourList;
 use super::removal::RemovalOutcome;
 use super::state::PackingState;
+use super::walls::WallKind;
+use crate::analysis::cubatic::cubatic_order;
+use crate::analysis::wall_order::aligned_fraction;
 use crate::analysis::{contact_numbers, nematic_order};
 use crate::rng::{DRIVER_STREAM, particle_stream};
 
@@ -52,7 +55,7 @@ pub fn init_mcm_workspace(world: &mut World) {
         .get_resource::<crate::RunSeed>()
         .map(|s| s.0)
         .unwrap_or(0);
-    let edge = world.resource::<Container>().edges().x;
+    let container = *world.resource::<Container>();
     let mut q = world.query::<(Entity, &ParticleId, &Position, &Orientation, &Shape)>();
     let mut rows: Vec<_> = q
         .iter(world)
@@ -63,7 +66,7 @@ pub fn init_mcm_workspace(world: &mut World) {
     let positions: Vec<DVec3> = rows.iter().map(|r| r.2).collect();
     let orientations: Vec<DQuat> = rows.iter().map(|r| r.3).collect();
     let shapes: Vec<Shape> = rows.iter().map(|r| r.4).collect();
-    let state = PackingState::from_si(edge, &positions, &orientations, &shapes, d);
+    let state = state_from_si(&container, &positions, &orientations, &shapes, d);
     let params = DriverParams::from_config(&config, d);
     let mut status = super::compress::initial_status(&params, &state);
     if let Some(old) = world.get_resource::<PackingStatus>() {
@@ -91,6 +94,53 @@ pub fn init_mcm_workspace(world: &mut World) {
 /// The driver's random stream when restored from a recording.
 #[derive(Resource, Debug, Clone)]
 pub struct DriverRng(pub Xoshiro256PlusPlus);
+
+/// The kernel's wall geometry (reduced units) of `container`, whose lengths are divided by
+/// the reference diameter `d` [m].
+pub fn wall_kind(container: &Container, d: f64) -> WallKind {
+    match container {
+        Container::PeriodicBox { .. } | Container::Unbounded => WallKind::Periodic,
+        Container::Walled { walls, edges } => match walls {
+            Walls::Cylinder => WallKind::Cylinder {
+                radius: 0.5 * edges.x / d,
+            },
+            Walls::Wedge { angle } => WallKind::Wedge { alpha: *angle },
+            Walls::Slab => WallKind::Slab,
+            Walls::Box => WallKind::Box,
+        },
+    }
+}
+
+/// The container of a kernel state with reference diameter `d` [m] (SI).
+pub fn container_of(state: &PackingState, d: f64) -> Container {
+    let edges = state.edges * d;
+    let walls = match state.walls {
+        WallKind::Periodic => return Container::PeriodicBox { edges },
+        WallKind::Cylinder { .. } => Walls::Cylinder,
+        WallKind::Wedge { alpha } => Walls::Wedge { angle: alpha },
+        WallKind::Slab => Walls::Slab,
+        WallKind::Box => Walls::Box,
+    };
+    Container::Walled { walls, edges }
+}
+
+/// A kernel state from SI data in `container`.
+pub fn state_from_si(
+    container: &Container,
+    positions: &[DVec3],
+    orientations: &[DQuat],
+    shapes: &[Shape],
+    d: f64,
+) -> PackingState {
+    PackingState::from_si(
+        container.edges(),
+        wall_kind(container, d),
+        positions,
+        orientations,
+        shapes,
+        d,
+    )
+}
 
 /// The reference diameter of a set of shapes: the smallest particle diameter 2R [m].
 pub fn reference_diameter<'a>(shapes: impl Iterator<Item = &'a Shape>) -> f64 {
@@ -155,10 +205,8 @@ pub fn write_back_particles(
     let d = ws.reference_diameter;
     let mut wrapped = ws.state.clone();
     wrapped.wrap_all();
-    let (edge, positions) = wrapped.to_si(d);
-    *container = Container::PeriodicBox {
-        edges: DVec3::splat(edge),
-    };
+    let (_, positions) = wrapped.to_si(d);
+    *container = container_of(&wrapped, d);
     for (k, e) in ws.entities.iter().enumerate() {
         if let Ok((mut p, mut o)) = q.get_mut(*e) {
             p.0 = positions[k];
@@ -184,6 +232,13 @@ pub struct PackingObservables {
     pub max_overlap: f64,
     /// Contact-number histogram (index = number of contacts).
     pub contact_histogram: Vec<u64>,
+    /// Fraction of rods near a wall that lie along it (4 deg, within 1 D; thesis fig. 2.6);
+    /// None without walls or rods.
+    pub wall_aligned_fraction: Option<f64>,
+    /// Cubatic order S_4 (eq. 4.17) of superquadrics; None without them.
+    pub cubatic_order: Option<f64>,
+    /// Largest penetration of a particle into a wall [m] (<= 0 without walls).
+    pub max_wall_penetration: f64,
     /// Whether they were ever computed.
     pub computed: bool,
 }
@@ -214,11 +269,24 @@ pub fn observe_packing(
     let d = reference_diameter(shapes.iter());
     let positions: Vec<DVec3> = rows.iter().map(|r| r.1).collect();
     let orientations: Vec<DQuat> = rows.iter().map(|r| r.2).collect();
-    let state = PackingState::from_si(container.edges().x, &positions, &orientations, &shapes, d);
+    let state = state_from_si(&container, &positions, &orientations, &shapes, d);
     let cn = contact_numbers(&state);
     let rod_axes: Vec<DVec3> = (0..state.len())
         .filter(|&i| state.bodies[i].half_length > 0.0)
         .map(|i| state.axis(i))
+        .collect();
+    let walled = state.walls != WallKind::Periodic;
+    let max_wall_penetration = if walled {
+        (0..state.len())
+            .map(|i| state.wall_penetration(i))
+            .fold(f64::NEG_INFINITY, f64::max)
+            * d
+    } else {
+        0.0
+    };
+    let sq: Vec<DQuat> = (0..state.len())
+        .filter(|&i| shapes[i].is_superquadric())
+        .map(|i| state.orientations[i])
         .collect();
     *obs = PackingObservables {
         step: clock.step,
@@ -228,6 +296,10 @@ pub fn observe_packing(
         nematic_order: nematic_order(&rod_axes),
         max_overlap: cn.max_overlap * d,
         contact_histogram: cn.histogram,
+        wall_aligned_fraction: (walled && !rod_axes.is_empty())
+            .then(|| aligned_fraction(&state)),
+        cubatic_order: (!sq.is_empty()).then(|| cubatic_order(&sq)),
+        max_wall_penetration,
         computed: true,
     };
 }

@@ -1,0 +1,218 @@
+//! The three sweeps and their charts.
+
+use std::path::Path;
+
+use serde_json::json;
+
+use super::{Point, half_width, point, rod};
+use crate::bench::BenchError;
+use crate::chart::{Chart, Figure, Line, Series, Style, write_svg};
+use crate::scene::ContainerSpec;
+use magsep_systems::analysis::confinement::{
+    bulk_extrapolation, rescaled_contact_number as rescaled_contacts,
+    rescaled_packing_fraction as rescaled_phi, rescaled_packing_fraction_wedge,
+};
+use magsep_systems::packing::walls::{wedge_min_length, wedge_min_packing_fraction};
+
+fn save(path: &Path, svg: &str) -> Result<(), BenchError> {
+    write_svg(path, svg).map_err(|e| BenchError::Runtime(format!("{}: {e}", path.display())))
+}
+
+fn out_dir(out: &Path) -> Result<(), BenchError> {
+    std::fs::create_dir_all(out).map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))
+}
+
+/// Sizes of a sweep: particles, runs per point.
+fn sizes(quick: bool, n_full: usize, runs_full: u64) -> (usize, u64) {
+    if quick { (60, 1) } else { (n_full, runs_full) }
+}
+
+/// Cylinder confinement (thesis figs. 2.10-2.11; spec 10.2): phi*, <C>* against D_cyl,
+/// S against D_cyl / aspect, and the 1/D_cyl extrapolation of phi.
+pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
+    out_dir(out)?;
+    let (n, runs) = sizes(quick, 200, 3);
+    let lambdas: Vec<f64> = if quick { vec![1.0, 3.0] } else { vec![1.0, 2.0, 3.0, 5.0] };
+    let diameters: Vec<f64> = if quick {
+        vec![1.5, 2.0, 3.0, 5.0]
+    } else {
+        vec![1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]
+    };
+    let mut phi_star = Chart::new("phi* = phi / phi_periodic").x_label("D_cyl / D").y_label("phi*");
+    let mut c_star = Chart::new("<C>* = (<C> - 2) / (<C>_periodic - 2)")
+        .x_label("D_cyl / D")
+        .y_label("<C>*");
+    let mut nem = Chart::new("nematic order").x_label("D_cyl / aspect ratio").y_label("S").x_log(true);
+    let mut extrap = Chart::new("phi against 1 / D_cyl (linear fit over D_cyl >= 3 D)")
+        .x_label("D / D_cyl")
+        .y_label("phi");
+    let mut summary = Vec::new();
+    for &l in &lambdas {
+        let phi0 = 0.05;
+        let per = point(format!("aspect {l} periodic"), n, rod(l), &ContainerSpec::PeriodicBox {}, phi0, runs)?;
+        let mut pts: Vec<(f64, Point)> = Vec::new();
+        for &d in diameters.iter().filter(|d| **d > 1.0) {
+            let spec = ContainerSpec::Cylinder { radius: 0.5 * d };
+            let p = point(format!("aspect {l} D_cyl {d}"), n, rod(l), &spec, phi0, runs)?;
+            pts.push((d, p));
+        }
+        let name = format!("aspect {l}");
+        let ps: Vec<(f64, f64)> = pts.iter().map(|(d, p)| (*d, rescaled_phi(p.phi.mean, per.phi.mean))).collect();
+        let pe: Vec<f64> = pts.iter().map(|(_, p)| half_width(&p.phi) / per.phi.mean).collect();
+        phi_star = phi_star.series(Series::new(name.clone(), ps).y_err(pe));
+        let cs: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|(d, p)| (*d, rescaled_contacts(p.contacts.mean, per.contacts.mean)))
+            .collect();
+        c_star = c_star.series(Series::new(name.clone(), cs));
+        if l > 1.0 {
+            nem = nem.series(Series::new(
+                name.clone(),
+                pts.iter().map(|(d, p)| (*d / l, p.nematic.mean)).collect::<Vec<_>>(),
+            ));
+        }
+        let (wd, wp): (Vec<f64>, Vec<f64>) =
+            pts.iter().filter(|(d, _)| *d >= 3.0).map(|(d, p)| (*d, p.phi.mean)).unzip();
+        let fit = bulk_extrapolation(&wd, &wp).map_err(|e| {
+            BenchError::Runtime(format!("aspect {l}: 1/D_cyl fit: {e}"))
+        })?;
+        extrap = extrap
+            .series(Series::new(name.clone(), pts.iter().map(|(d, p)| (1.0 / d, p.phi.mean)).collect::<Vec<_>>()).style(Style::Markers))
+            .line(Line::new(format!("{name}: fit, bulk {:.3} (periodic {:.3})", fit.intercept, per.phi.mean), vec![(0.0, fit.intercept), (1.0 / 3.0, fit.intercept + fit.slope / 3.0)]).dashed(true));
+        summary.push(json!({
+            "aspect_ratio": l,
+            "periodic": per,
+            "extrapolated_bulk_phi": fit.intercept,
+            "extrapolated_bulk_phi_stderr": fit.intercept_stderr,
+            "extrapolation_vs_periodic": fit.intercept / per.phi.mean - 1.0,
+            "points": pts.iter().map(|(d, p)| json!({"d_cyl": d, "point": p})).collect::<Vec<_>>(),
+        }));
+    }
+    nem = nem
+        .line(Line::new("1.5", vec![(1.5, 0.0), (1.5, 1.0)]).dashed(true))
+        .line(Line::new("0.75", vec![(0.75, 0.0), (0.75, 1.0)]).dashed(true));
+    let fig = Figure::new(format!("Spherocylinders in a hard cylinder, N = {n}, {runs} runs per point (95 % intervals)"), 2)
+        .panel(phi_star)
+        .panel(c_star)
+        .panel(nem)
+        .panel(extrap);
+    let path = out.join("cylinder_confinement.svg");
+    save(&path, &fig.to_svg(560.0, 420.0))?;
+    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary}));
+    Ok(())
+}
+
+/// Wedge confinement (thesis figs. 2.12-2.16; spec 10.3): phi*, <C>* against l_w / l_w,min and
+/// the wall-aligned fraction against the aspect ratio.
+pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
+    out_dir(out)?;
+    let (n, runs) = sizes(quick, 200, 3);
+    let deg = std::f64::consts::PI / 180.0;
+    let angles: Vec<f64> = if quick { vec![9.0, 45.0] } else { vec![9.0, 15.0, 30.0, 45.0] };
+    let lambdas: Vec<f64> = if quick { vec![1.0, 3.0] } else { vec![1.0, 1.25, 2.0, 3.0, 5.0] };
+    let ratios: Vec<f64> = if quick { vec![2.0] } else { vec![1.5, 3.0, 5.0] };
+    let mut phi_star = Chart::new("phi* = (phi - phi_min) / (phi_periodic - phi_min), alpha = 9 deg")
+        .x_label("l_w / l_w,min")
+        .y_label("phi*");
+    let mut c_star = Chart::new("<C>*, alpha = 9 deg").x_label("l_w / l_w,min").y_label("<C>*");
+    let mut align = Chart::new("wall-aligned fraction (4 deg, within 1 D), largest l_w")
+        .x_label("aspect ratio")
+        .y_label("f_align");
+    let mut summary = Vec::new();
+    let mut periodic = Vec::new();
+    for &l in &lambdas {
+        periodic.push(point(format!("aspect {l} periodic"), n, rod(l), &ContainerSpec::PeriodicBox {}, 0.05, runs)?);
+    }
+    for &a in &angles {
+        let mut fa = Vec::new();
+        for (k, &l) in lambdas.iter().enumerate() {
+            let lmin = wedge_min_length(0.5, l - 1.0, a * deg);
+            let phimin = wedge_min_packing_fraction(0.5, l - 1.0, a * deg);
+            let mut pts = Vec::new();
+            for &r in &ratios {
+                let spec = ContainerSpec::Wedge { angle: a * deg, length: r * lmin };
+                let p = point(format!("alpha {a} aspect {l} l/lmin {r}"), n, rod(l), &spec, 0.05, runs)?;
+                pts.push((r, p));
+            }
+            if a == angles[0] {
+                let per = &periodic[k];
+                phi_star = phi_star.series(Series::new(
+                    format!("aspect {l}"),
+                    pts.iter().map(|(r, p)| (*r, rescaled_packing_fraction_wedge(p.phi.mean, per.phi.mean, phimin))).collect::<Vec<_>>(),
+                ));
+                c_star = c_star.series(Series::new(
+                    format!("aspect {l}"),
+                    pts.iter().map(|(r, p)| (*r, rescaled_contacts(p.contacts.mean, per.contacts.mean))).collect::<Vec<_>>(),
+                ));
+            }
+            if let Some((_, p)) = pts.last() {
+                fa.push((l, p.aligned.mean, half_width(&p.aligned)));
+            }
+            summary.push(json!({"angle_deg": a, "aspect_ratio": l, "l_w_min": lmin, "phi_l_w_min": phimin, "periodic": periodic[k], "points": pts.iter().map(|(r, p)| json!({"l_w_over_min": r, "point": p})).collect::<Vec<_>>()}));
+        }
+        align = align.series(
+            Series::new(format!("alpha = {a} deg"), fa.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>())
+                .y_err(fa.iter().map(|p| p.2).collect::<Vec<_>>()),
+        );
+    }
+    align = align
+        .line(Line::new("thesis: 0.5 (aspect <= 2)", vec![(1.0, 0.5), (2.0, 0.5)]).dashed(true))
+        .line(Line::new("thesis: > 0.8 (aspect >= 3)", vec![(3.0, 0.8), (5.0, 0.8)]).dashed(true));
+    let fig = Figure::new(format!("Spherocylinders in a hard wedge, N = {n}, {runs} runs per point"), 3)
+        .panel(phi_star)
+        .panel(c_star)
+        .panel(align);
+    let path = out.join("wedge_confinement.svg");
+    save(&path, &fig.to_svg(520.0, 420.0))?;
+    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary}));
+    Ok(())
+}
+
+/// Superballs (thesis figs. 4.5-4.6; spec 10.4): phi, <C>, S_4 and the nematic order against
+/// the exponent, with the thesis's values.
+pub fn chart_superballs(out: &Path, quick: bool) -> Result<(), BenchError> {
+    out_dir(out)?;
+    let (n, runs) = sizes(quick, 750, 2);
+    let exponents: Vec<f64> = if quick { vec![2.0, 3.0, 5.0] } else { vec![2.0, 2.25, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0] };
+    let mut pts = Vec::new();
+    for &g in &exponents {
+        let shape = magsep_components::shape::Shape::Superquadric {
+            semi_axes: glam::DVec3::splat(0.5),
+            exponents: glam::DVec3::splat(g),
+        };
+        pts.push((g, point(format!("superball g = {g}"), n, shape, &ContainerSpec::PeriodicBox {}, 0.05, runs)?));
+    }
+    let series = |f: fn(&Point) -> (f64, f64)| -> (Vec<(f64, f64)>, Vec<f64>) {
+        (pts.iter().map(|(g, p)| (*g, f(p).0)).collect(), pts.iter().map(|(_, p)| f(p).1).collect())
+    };
+    let (phi, phie) = series(|p| (p.phi.mean, half_width(&p.phi)));
+    let (c, ce) = series(|p| (p.contacts.mean, half_width(&p.contacts)));
+    let (s4, _) = series(|p| (p.cubatic.mean, half_width(&p.cubatic)));
+    let fig = Figure::new(format!("Superballs, N = {n}, periodic, {runs} runs per point"), 3)
+        .panel(
+            Chart::new("packing fraction")
+                .x_label("exponent g")
+                .y_label("phi")
+                .series(Series::new("magsep (FIRE)", phi).y_err(phie))
+                .line(Line::new("thesis, g = 2: 0.61", vec![(2.0, 0.61), (2.3, 0.61)]).dashed(true))
+                .line(Line::new("RCP 0.64", vec![(2.0, 0.64), (5.0, 0.64)]).dashed(true)),
+        )
+        .panel(
+            Chart::new("mean contact number")
+                .x_label("exponent g")
+                .y_label("<C> (extrapolated)")
+                .series(Series::new("magsep", c).y_err(ce))
+                .line(Line::new("thesis: 5.84 - 1.25 (g - 2)", vec![(2.0, 5.84), (5.0, 2.09)]).dashed(true)),
+        )
+        .panel(
+            Chart::new("cubatic order S_4")
+                .x_label("exponent g")
+                .y_label("S_4")
+                .series(Series::new("magsep", s4))
+                .line(Line::new("finite-size floor ~0.04 (N = 750)", vec![(2.0, 0.04), (5.0, 0.04)]).dashed(true)),
+        );
+    let path = out.join("superballs.svg");
+    save(&path, &fig.to_svg(520.0, 420.0))?;
+    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "points": pts.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>()}));
+    Ok(())
+}

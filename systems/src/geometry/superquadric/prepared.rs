@@ -1,0 +1,261 @@
+//! Per-call constants of one superquadric and the hot kernels built on them: inside function,
+//! gradient and diagonal second derivatives in one pass (3 powers per point), the support
+//! map and the radial projection onto the surface.
+//!
+//! Support map. For a body-frame direction w the support point maximises w . x subject to
+//! sum |x_i/a_i|^g_i <= 1. With c_i = |w_i| a_i, y_i = |x_i|/a_i and the dual exponents
+//! p_i = g_i/(g_i - 1), the Lagrange conditions give y_i = (c_i mu / g_i)^(1/(g_i - 1)) with
+//! mu solving sum_i (c_i mu / g_i)^p_i = 1. Equal exponents: y_i = (c_i / ||c||_p)^(p - 1),
+//! closed form. Unequal exponents: psi(t) = ln sum_i exp(p_i (ln(c_i/g_i) + t)), t = ln mu, is
+//! convex and increasing (slope in [p_min, p_max] within (1, 2]); Newton from any start lands
+//! right of the root after one step and then decreases monotonically to it, so the iteration
+//! cannot diverge or cycle.
+
+use glam::DVec3;
+
+/// How y^(g - 2) is evaluated on one axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Pow {
+    /// g = 2: y^0 = 1.
+    One,
+    /// Integer g - 2 (up to 16): repeated multiplication.
+    Int(i32),
+    /// General exponent g - 2: `powf`.
+    Real(f64),
+}
+
+impl Pow {
+    fn new(e: f64) -> Self {
+        if e == 0.0 {
+            Pow::One
+        } else if e.fract() == 0.0 && e <= 16.0 {
+            Pow::Int(e as i32)
+        } else {
+            Pow::Real(e)
+        }
+    }
+
+    #[inline(always)]
+    fn apply(self, y: f64) -> f64 {
+        match self {
+            Pow::One => 1.0,
+            Pow::Int(n) => y.powi(n),
+            Pow::Real(e) => y.powf(e),
+        }
+    }
+}
+
+/// x^e for x >= 0 and e in (0, 1], with square-root fast paths for e = 1/2, 1/4, 1/8.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Root {
+    One,
+    Half,
+    Quarter,
+    Eighth,
+    Real(f64),
+}
+
+impl Root {
+    fn new(e: f64) -> Self {
+        if e == 1.0 {
+            Root::One
+        } else if e == 0.5 {
+            Root::Half
+        } else if e == 0.25 {
+            Root::Quarter
+        } else if e == 0.125 {
+            Root::Eighth
+        } else {
+            Root::Real(e)
+        }
+    }
+
+    #[inline(always)]
+    fn apply(self, x: f64) -> f64 {
+        match self {
+            Root::One => x,
+            Root::Half => x.sqrt(),
+            Root::Quarter => x.sqrt().sqrt(),
+            Root::Eighth => x.sqrt().sqrt().sqrt(),
+            Root::Real(e) => x.powf(e),
+        }
+    }
+}
+
+/// Inside function, gradient (eq. 4.6) and diagonal second derivatives (eq. 4.33) at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Eval {
+    /// F = sum |x_i/a_i|^g_i - 1.
+    pub f: f64,
+    /// dF/dx (unnormalised outward normal).
+    pub grad: DVec3,
+    /// d^2F/dx_i^2 (the Hessian is diagonal).
+    pub hess: DVec3,
+}
+
+/// Constants of one superquadric used in the hot loops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Prepared {
+    pub a: DVec3,
+    pub inv_a: DVec3,
+    pub g: DVec3,
+    pub pow: [Pow; 3],
+    pub equal: bool,
+    /// x^(1/(g-1)) (equal exponents; the support map).
+    dual: Root,
+    /// x^(1/g) (equal exponents; support normalisation and radial projection).
+    inv_g: Root,
+}
+
+impl Prepared {
+    pub fn new(a: DVec3, g: DVec3) -> Self {
+        Self {
+            a,
+            inv_a: a.recip(),
+            g,
+            pow: [
+                Pow::new(g.x - 2.0),
+                Pow::new(g.y - 2.0),
+                Pow::new(g.z - 2.0),
+            ],
+            equal: g.x == g.y && g.y == g.z,
+            dual: Root::new(1.0 / (g.x - 1.0)),
+            inv_g: Root::new(1.0 / g.x),
+        }
+    }
+
+    /// F, gradient and diagonal Hessian at `x` (three powers).
+    #[inline]
+    pub fn eval(&self, x: DVec3) -> Eval {
+        let mut f = -1.0;
+        let mut grad = DVec3::ZERO;
+        let mut hess = DVec3::ZERO;
+        for i in 0..3 {
+            let y = x[i].abs() * self.inv_a[i];
+            let ym2 = self.pow[i].apply(y);
+            let ym1 = ym2 * y;
+            f += ym1 * y;
+            let g = self.g[i];
+            grad[i] = (g * self.inv_a[i] * ym1).copysign(x[i]);
+            hess[i] = g * (g - 1.0) * self.inv_a[i] * self.inv_a[i] * ym2;
+        }
+        Eval { f, grad, hess }
+    }
+
+    /// F at `x`.
+    #[inline]
+    pub fn inside(&self, x: DVec3) -> f64 {
+        let mut f = -1.0;
+        for i in 0..3 {
+            let y = x[i].abs() * self.inv_a[i];
+            f += self.pow[i].apply(y) * y * y;
+        }
+        f
+    }
+
+    /// The surface point on the ray through `x` (`x` unchanged if it is the centre or not
+    /// finite). `s` = sum |x_i/a_i|^g_i = F + 1 if already known.
+    pub fn project_radial(&self, x: DVec3, s: f64) -> DVec3 {
+        if !(s.is_finite() && s > 0.0) {
+            return x;
+        }
+        if self.equal {
+            return x * (1.0 / self.inv_g.apply(s));
+        }
+        // sum_i w_i l^g_i = 1 with w_i = |x_i/a_i|^g_i: Newton on ln sum exp(ln w_i + g_i tau)
+        let mut lw = [f64::NEG_INFINITY; 3];
+        for i in 0..3 {
+            let y = x[i].abs() * self.inv_a[i];
+            if y > 0.0 {
+                lw[i] = self.g[i] * y.ln();
+            }
+        }
+        let tau = monotone_log_newton(&lw, &[self.g.x, self.g.y, self.g.z], 0.0);
+        x * tau.exp()
+    }
+
+    /// Support point in the body frame for the (not necessarily unit) direction `w`; the
+    /// centre for a zero or non-finite direction.
+    #[inline]
+    pub fn support(&self, w: DVec3) -> DVec3 {
+        let c = (w * self.a).abs();
+        let cmax = c.max_element();
+        if !(cmax.is_finite() && cmax > 0.0) {
+            return DVec3::ZERO;
+        }
+        let z = c * (1.0 / cmax); // in [0, 1], max 1
+        let y = if self.equal {
+            // y_i = z_i^(p-1) / ||z||_p^(p-1), p - 1 = 1/(g-1), ||z||_p^(p-1) = (sum z^p)^(1/g)
+            let e = DVec3::new(
+                self.dual.apply(z.x),
+                self.dual.apply(z.y),
+                self.dual.apply(z.z),
+            );
+            let zp = e * z;
+            e * (1.0 / self.inv_g.apply(zp.x + zp.y + zp.z))
+        } else {
+            let mut lc = [f64::NEG_INFINITY; 3];
+            let mut lb = [f64::NEG_INFINITY; 3];
+            let mut p = [0.0; 3];
+            for i in 0..3 {
+                p[i] = self.g[i] / (self.g[i] - 1.0);
+                if z[i] > 0.0 {
+                    lc[i] = (z[i] / self.g[i]).ln();
+                    lb[i] = p[i] * lc[i];
+                }
+            }
+            let t = monotone_log_newton(&lb, &p, 0.0);
+            let mut y = DVec3::ZERO;
+            for i in 0..3 {
+                if z[i] > 0.0 {
+                    y[i] = ((lc[i] + t) / (self.g[i] - 1.0)).exp();
+                }
+            }
+            y
+        };
+        (y * self.a).copysign(w)
+    }
+}
+
+/// Root t of psi(t) = ln sum_i exp(lb_i + p_i t) (terms with lb_i = -inf are absent), for
+/// p_i > 0: psi is convex and increasing, so Newton started anywhere is monotone after its
+/// first step. Returns `t0` if every term is absent.
+pub(crate) fn monotone_log_newton(lb: &[f64; 3], p: &[f64; 3], t0: f64) -> f64 {
+    if lb.iter().all(|v| *v == f64::NEG_INFINITY) {
+        return t0;
+    }
+    // shift by the largest lb for a stable log-sum-exp
+    let mut t = t0;
+    let mut last = f64::INFINITY;
+    for it in 0..100 {
+        let mut m = f64::NEG_INFINITY;
+        for i in 0..3 {
+            if lb[i] > f64::NEG_INFINITY {
+                m = m.max(lb[i] + p[i] * t);
+            }
+        }
+        let (mut s, mut ds) = (0.0, 0.0);
+        for i in 0..3 {
+            if lb[i] > f64::NEG_INFINITY {
+                let e = (lb[i] + p[i] * t - m).exp();
+                s += e;
+                ds += p[i] * e;
+            }
+        }
+        let psi = m + s.ln();
+        let step = psi * s / ds;
+        if !step.is_finite() {
+            break;
+        }
+        // after the first step the iterates decrease monotonically to the root
+        if it >= 2 && !(step > 0.0 && step < last) {
+            break;
+        }
+        t -= step;
+        last = step.abs();
+        if last <= 1e-16 * (1.0 + t.abs()) {
+            break;
+        }
+    }
+    t
+}

@@ -1,1 +1,0 @@
-//! Virtual-particle walls (placeholder, being written).
