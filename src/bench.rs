@@ -230,13 +230,13 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
         let mut t = vec![glam::DVec3::ZERO; n];
         let t0 = Instant::now();
         for _ in 0..reps {
-            std::hint::black_box(overlap_forces(&state, &list, &mut f, &mut t));
+            std::hint::black_box(overlap_forces(&state, &mut list, &mut f, &mut t));
         }
         let per_force = t0.elapsed().as_secs_f64() / reps as f64;
         let mut flags = Vec::new();
         let t0 = Instant::now();
         for _ in 0..reps {
-            std::hint::black_box(overlap_scan(&state, &list, 1e-4, &mut flags));
+            std::hint::black_box(overlap_scan(&state, &mut list, 1e-4, &mut flags));
         }
         let per_scan = t0.elapsed().as_secs_f64() / reps as f64;
         let t0 = Instant::now();

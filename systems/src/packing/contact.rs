@@ -108,7 +108,8 @@ pub fn pair_contact(
 /// Contact of two bodies of which at least one is a superquadric (a sphere is treated as the
 /// superquadric with exponents 2). Rods of nonzero length cannot meet superquadrics (scene
 /// validation rejects such mixtures); they are approximated by their circumscribed
-/// spheroid and flagged as a fallback.
+/// spheroid and flagged as a fallback. `warm` is the pair's cached Newton start, replaced by
+/// this solution.
 pub fn superquadric_contact(
     a: &Body,
     xa: DVec3,
@@ -116,6 +117,7 @@ pub fn superquadric_contact(
     b: &Body,
     xb: DVec3,
     qb: DQuat,
+    warm: &mut Option<sq::WarmStart>,
 ) -> PairContact {
     let sa = as_superquadric(a);
     let sb = as_superquadric(b);
@@ -123,7 +125,10 @@ pub fn superquadric_contact(
         gap_cutoff: 0.05,
         ..ContactOptions::default()
     };
-    let r = sq::contact(&sa.0, xa, qa, &sb.0, xb, qb, &opts, None);
+    let r = sq::contact(&sa.0, xa, qa, &sb.0, xb, qb, &opts, warm.as_ref());
+    if r.warm.is_some() {
+        *warm = r.warm;
+    }
     PairContact {
         overlap: r.overlap,
         normal: r.normal,

@@ -50,7 +50,7 @@ impl Default for FireParams {
 /// contact-solver fallbacks).
 pub fn overlap_forces(
     state: &PackingState,
-    list: &NeighbourList,
+    list: &mut NeighbourList,
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
@@ -59,8 +59,10 @@ pub fn overlap_forces(
     let mut max_overlap: f64 = 0.0;
     let mut energy = 0.0;
     let mut fallbacks = 0;
-    for (i, j, shift) in list.unique_pairs(state.edges) {
-        let c = state.contact(i, j, shift);
+    let pairs: Vec<(usize, usize, usize)> = list.unique_entries().collect();
+    for (i, j, k) in pairs {
+        let shift = list.entry(k).shift(state.edges);
+        let c = state.contact_warm(i, j, shift, list.warm_mut(k));
         fallbacks += c.fallback as u64;
         if c.overlap <= 0.0 {
             continue;

@@ -15,6 +15,7 @@ use glam::DVec3;
 
 use super::state::{BodyKind, PackingState};
 use crate::geometry::segment_closest;
+use crate::geometry::superquadric::WarmStart;
 
 /// One neighbour entry: particle `j` in periodic image `image` (its centre is
 /// x_j + image * edge, with the edge of the moment: compressions rescale the shift).
@@ -160,6 +161,9 @@ pub struct NeighbourList {
     /// Number of builds.
     pub builds: u64,
     valid: bool,
+    /// Superquadric contact solutions per directed entry, the next call's Newton start
+    /// (carried over rebuilds for pairs that stay listed).
+    warm: Vec<Option<WarmStart>>,
 }
 
 impl NeighbourList {
@@ -304,6 +308,9 @@ impl NeighbourList {
             count[i as usize] += 1;
             count[j as usize] += 1;
         }
+        let old_start = std::mem::take(&mut self.start);
+        let old_entries = std::mem::take(&mut self.entries);
+        let old_warm = std::mem::take(&mut self.warm);
         self.start = vec![0; n + 1];
         for (i, c) in count.iter().take(n).enumerate() {
             self.start[i + 1] = self.start[i] + c;
@@ -326,11 +333,52 @@ impl NeighbourList {
             };
             fill[j as usize] += 1;
         }
+        self.warm = vec![None; self.entries.len()];
+        if old_start.len() == n + 1 && old_warm.len() == old_entries.len() {
+            for i in 0..n {
+                let old = old_start[i] as usize..old_start[i + 1] as usize;
+                for k in self.start[i] as usize..self.start[i + 1] as usize {
+                    if let Some(o) = old.clone().find(|&o| old_entries[o] == self.entries[k]) {
+                        self.warm[k] = old_warm[o];
+                    }
+                }
+            }
+        }
         self.moved = vec![0.0; n];
         self.max_moved = 0.0;
         self.compressed = 0.0;
         self.valid = true;
         self.builds += 1;
+    }
+
+    /// Each unordered pair once with its directed entry index (for [`Self::warm_mut`]).
+    pub fn unique_entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        (0..self.start.len().saturating_sub(1)).flat_map(move |i| {
+            let first = self.start[i] as usize;
+            self.of(i).iter().enumerate().filter_map(move |(k, nb)| {
+                let j = nb.j as usize;
+                let keep = j > i || (j == i && nb.image > [0, 0, 0]);
+                keep.then_some((i, j, first + k))
+            })
+        })
+    }
+
+    /// Index of i's first entry (entries of i are `entry_start(i)..` in [`Self::of`] order).
+    #[inline]
+    pub fn entry_start(&self, i: usize) -> usize {
+        self.start[i] as usize
+    }
+
+    /// The entry `k`.
+    #[inline]
+    pub fn entry(&self, k: usize) -> Neighbour {
+        self.entries[k]
+    }
+
+    /// The cached contact solution of entry `k`.
+    #[inline]
+    pub fn warm_mut(&mut self, k: usize) -> &mut Option<WarmStart> {
+        &mut self.warm[k]
     }
 
     /// Each unordered pair once: (i, j, shift) with i < j, or i == j for self-image pairs;

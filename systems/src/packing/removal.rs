@@ -34,14 +34,16 @@ pub struct RemovalOutcome {
 /// written into `out`.
 pub fn overlapping_contacts(
     state: &PackingState,
-    list: &NeighbourList,
+    list: &mut NeighbourList,
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
 ) {
     out.clear();
-    for nb in list.of(i) {
-        let c = state.contact(i, nb.j as usize, nb.shift(state.edges));
+    let first = list.entry_start(i);
+    for k in first..first + list.of(i).len() {
+        let nb = list.entry(k);
+        let c = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), list.warm_mut(k));
         if c.overlap > tol {
             out.push(MoveContact::from(&c));
         }
@@ -67,15 +69,17 @@ pub struct OverlapScan {
 /// Total overlap (pairs and walls) and the flags of particles with an overlap above `tol`.
 pub fn overlap_scan(
     state: &PackingState,
-    list: &NeighbourList,
+    list: &mut NeighbourList,
     tol: f64,
     flags: &mut Vec<bool>,
 ) -> OverlapScan {
     flags.clear();
     flags.resize(state.len(), false);
     let mut scan = OverlapScan::default();
-    for (i, j, shift) in list.unique_pairs(state.edges) {
-        let c = state.contact(i, j, shift);
+    let pairs: Vec<(usize, usize, usize)> = list.unique_entries().collect();
+    for (i, j, k) in pairs {
+        let shift = list.entry(k).shift(state.edges);
+        let c = state.contact_warm(i, j, shift, list.warm_mut(k));
         scan.contacts += 1;
         scan.fallbacks += c.fallback as u64;
         if c.overlap > 0.0 {

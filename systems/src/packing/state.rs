@@ -14,7 +14,7 @@ use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
 use super::walls::{self, WallContact, WallKind};
-use crate::geometry::superquadric::Superquadric;
+use crate::geometry::superquadric::{Superquadric, WarmStart};
 use crate::geometry::{bounding_radius, inertia_body_unit_density, volume};
 use crate::packing::contact::{PairContact, pair_contact, superquadric_contact};
 
@@ -224,6 +224,30 @@ impl PackingState {
         )
     }
 
+    /// [`Self::contact`] with the cached superquadric solution of the pair, updated.
+    #[inline]
+    pub fn contact_warm(
+        &self,
+        i: usize,
+        j: usize,
+        shift: DVec3,
+        warm: &mut Option<WarmStart>,
+    ) -> PairContact {
+        let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
+        if let (BodyKind::Rod, BodyKind::Rod) = (bi.kind, bj.kind) {
+            return self.contact(i, j, shift);
+        }
+        superquadric_contact(
+            bi,
+            self.positions[i],
+            self.orientations[i],
+            bj,
+            self.positions[j] + shift,
+            self.orientations[j],
+            warm,
+        )
+    }
+
     /// Wall contacts of particle `i` with overlap > `-margin` (virtual rods for spheres and
     /// spherocylinders, the deepest-point rule for superquadrics), appended to `out`.
     pub fn wall_contacts(&self, i: usize, margin: f64, out: &mut Vec<PairContact>) {
@@ -329,6 +353,6 @@ pub fn body_contact(
             b.half_length,
             b.radius,
         ),
-        _ => superquadric_contact(a, xa, qa, b, xb, qb),
+        _ => superquadric_contact(a, xa, qa, b, xb, qb, &mut None),
     }
 }
