@@ -66,7 +66,14 @@ pub fn packing_run(
     seed: u64,
     stop_at: f64,
 ) -> Result<PackingRun, BenchError> {
-    packing_run_in(n, shape, config, seed, stop_at, &ContainerSpec::PeriodicBox {})
+    packing_run_in(
+        n,
+        shape,
+        config,
+        seed,
+        stop_at,
+        &ContainerSpec::PeriodicBox {},
+    )
 }
 
 /// [`packing_run`] in the container `spec` (SI lengths = reduced units here, D = 1).
@@ -124,8 +131,12 @@ fn loose_spheres(
         .collect();
     let vp: f64 = bodies.iter().map(|b| b.volume).sum();
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
-    let mut state = random_insertion(&bodies, PackingState::periodic_cube((vp / phi).cbrt()), &mut rngs)
-        .map_err(|e| BenchError::Runtime(e.to_string()))?;
+    let mut state = random_insertion(
+        &bodies,
+        PackingState::periodic_cube((vp / phi).cbrt()),
+        &mut rngs,
+    )
+    .map_err(|e| BenchError::Runtime(e.to_string()))?;
     let mut list = NeighbourList::new(MCM_SKIN);
     list.build(&mut state);
     Ok((state, list))

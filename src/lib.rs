@@ -22,8 +22,8 @@ pub mod fieldtool;
 pub mod packing_charts;
 pub mod replay;
 pub mod scene;
-pub mod sq_study;
 pub mod sim;
+pub mod sq_study;
 pub mod summary;
 
 pub use sim::{RunOptions, SimError, Simulation};

@@ -61,9 +61,7 @@ pub fn load_frame(
         if !(r.is_finite() && r > 0.0 && h.is_finite() && h >= 0.0) {
             return Err(bad(format!("particle {id}: radius {r}, half length {h}")));
         }
-        let scene_shape = shapes
-            .filter(|s| s.len() == frame.ids.len())
-            .map(|s| s[i]);
+        let scene_shape = shapes.filter(|s| s.len() == frame.ids.len()).map(|s| s[i]);
         let shape = if let Some(s) = scene_shape {
             s
         } else if h == 0.0 {

@@ -47,11 +47,19 @@ fn run_recorded(text: &str, tag: &str) -> (f64, serde_json::Value, std::path::Pa
     let frame = rec.frames.last().unwrap();
     let status: magsep::plugins::recorder::FrameStatus =
         serde_json::from_str(&frame.status_json).unwrap();
-    let container = status.container.expect("walled frames record their container");
+    let container = status
+        .container
+        .expect("walled frames record their container");
     assert_eq!(container.edges(), frame.box_edges);
     let shapes = s.shapes();
     let d = s.reference_diameter();
-    let state = state_from_si(&container, &frame.positions, &frame.orientations, &shapes, d);
+    let state = state_from_si(
+        &container,
+        &frame.positions,
+        &frame.orientations,
+        &shapes,
+        d,
+    );
     let worst = (0..state.len())
         .map(|i| state.wall_penetration(i))
         .fold(f64::NEG_INFINITY, f64::max);
@@ -65,7 +73,11 @@ fn no_particle_penetrates_any_wall_kind_in_the_recorded_final_packing() {
     let cases = [
         ("cyl_rods", "kind = \"cylinder\"\nradius = 2.0", rodshape),
         ("cyl_spheres", "kind = \"cylinder\"\nradius = 1.5", sphere),
-        ("wedge", "kind = \"wedge\"\nangle = 0.5\nlength = 12.0", rodshape),
+        (
+            "wedge",
+            "kind = \"wedge\"\nangle = 0.5\nlength = 12.0",
+            rodshape,
+        ),
         ("slab", "kind = \"slab\"\nside = 6.0", rodshape),
         ("box", "kind = \"closed_box\"", sphere),
     ];
@@ -75,7 +87,10 @@ fn no_particle_penetrates_any_wall_kind_in_the_recorded_final_packing() {
         assert!(worst <= 1e-4, "{tag}: penetration {worst} D");
         let phi = summary["packing_fraction"].as_f64().unwrap();
         assert!(phi > 0.2 && phi < 0.8, "{tag}: phi {phi}");
-        assert!(summary["max_wall_penetration"].as_f64().unwrap() <= 1e-4, "{tag}");
+        assert!(
+            summary["max_wall_penetration"].as_f64().unwrap() <= 1e-4,
+            "{tag}"
+        );
         assert!(summary["container"].is_object(), "{tag}");
     }
 }
@@ -97,7 +112,10 @@ fn superballs_pack_with_counted_solver_fallbacks() {
     let evals = summary["contact_evaluations"].as_u64().unwrap();
     let fallbacks = summary["contact_fallbacks"].as_u64().unwrap();
     assert!(evals > 1000);
-    assert!(fallbacks * 1000 <= evals, "{fallbacks} fallbacks in {evals}");
+    assert!(
+        fallbacks * 1000 <= evals,
+        "{fallbacks} fallbacks in {evals}"
+    );
     let s4 = summary["cubatic_order"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&s4), "S4 {s4}");
 }
@@ -121,7 +139,12 @@ fn ellipsoids_in_a_cylinder_stay_inside() {
 fn container_and_shape_errors_name_their_key_paths() {
     let bad = [
         (
-            scene("kind = \"cylinder\"\nradius = 0.3", r#"{ kind = "sphere", radius = 0.5 }"#, 5, ""),
+            scene(
+                "kind = \"cylinder\"\nradius = 0.3",
+                r#"{ kind = "sphere", radius = 0.5 }"#,
+                5,
+                "",
+            ),
             "container.radius",
         ),
         (
@@ -152,7 +175,12 @@ fn container_and_shape_errors_name_their_key_paths() {
             "packing.scheme",
         ),
         (
-            scene("kind = \"slab\"\nside = -1.0", r#"{ kind = "sphere", radius = 0.5 }"#, 5, ""),
+            scene(
+                "kind = \"slab\"\nside = -1.0",
+                r#"{ kind = "sphere", radius = 0.5 }"#,
+                5,
+                "",
+            ),
             "container.side",
         ),
     ];
@@ -216,7 +244,11 @@ placement = {{ kind = "box", min = [20.0, 20.0, 20.0], max = [21.0, 21.0, 21.0] 
         .iter()
         .map(|f| std::f64::consts::PI * f.radius * f.radius * 2.0 * f.half_length)
         .sum();
-    assert!((v_fibres / v_column - phi).abs() < 1e-9, "{} vs {phi}", v_fibres / v_column);
+    assert!(
+        (v_fibres / v_column - phi).abs() < 1e-9,
+        "{} vs {phi}",
+        v_fibres / v_column
+    );
     let mut sim = Simulation::from_scene(&s, RunOptions::default()).unwrap();
     sim.run(|_| {}).unwrap();
     // a missing recording is reported under the entry's key path

@@ -84,7 +84,9 @@ impl Container {
 
 /// One face of a hard-wall container, spawned as a boundary entity (its geometry follows the
 /// [`Container`] resource, which compression changes).
-#[derive(bevy_ecs::prelude::Component, Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    bevy_ecs::prelude::Component, Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize,
+)]
 pub enum WallFace {
     /// The cylinder's lateral wall.
     CylinderWall,

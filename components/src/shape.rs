@@ -59,7 +59,9 @@ impl Shape {
     /// semi-axis for a superquadric.
     pub fn aspect_ratio(&self) -> f64 {
         match *self {
-            Shape::Superquadric { semi_axes, .. } => semi_axes.max_element() / semi_axes.min_element(),
+            Shape::Superquadric { semi_axes, .. } => {
+                semi_axes.max_element() / semi_axes.min_element()
+            }
             _ => 1.0 + self.half_length() / self.radius(),
         }
     }

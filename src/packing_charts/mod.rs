@@ -1,6 +1,10 @@
 //! `magsep chart cylinder | wedge | superballs`: the confinement and shape studies of thesis 000
 //! (ch. 2 figs. 2.10-2.16, ch. 4 figs. 4.5-4.6) as SVG charts with a JSON summary.
 //!
+//! Sizes are reduced from the thesis's (N = 500, 5 runs; superballs N = 750) to finish in
+//! about half an hour on two cores: 120 particles and 2 runs per point (superballs 60), stated
+//! in every chart's title. `--quick` runs a smoke version.
+//!
 //! Every point is the mean of independent runs (seeds 1..=runs) with a Student-t 95 % interval.
 //! Periodic reference runs of the same shapes give phi_periodic and <C>_periodic for the
 //! rescaled measures phi* and <C>* (spec packing.md 9.8). Runs go in parallel over rayon;
@@ -8,9 +12,10 @@
 
 mod sweeps;
 
+pub use magsep_components::packing::OverlapRemovalScheme as Scheme;
 pub use sweeps::{chart_cylinder, chart_superballs, chart_wedge};
 
-use magsep_components::packing::PackingConfig;
+use magsep_components::packing::{OverlapRemovalScheme, PackingConfig};
 use magsep_components::shape::Shape;
 use magsep_systems::analysis::cubatic::cubatic_order;
 use magsep_systems::analysis::wall_order::aligned_fraction;
@@ -49,15 +54,24 @@ pub fn measure(
     container: &ContainerSpec,
     phi0: f64,
     seed: u64,
+    scheme: OverlapRemovalScheme,
 ) -> Result<RunMeasures, BenchError> {
     let mut cfg = PackingConfig::defaults_for(n, 1.0);
     cfg.initial_packing_fraction = phi0;
+    cfg.scheme = scheme;
+    cfg.max_attempts = PackingConfig::default_max_attempts(scheme, n);
     let r = packing_run_in(n, shape, &cfg, seed, f64::INFINITY, container)?;
     let st = &r.state;
     let penetration = (0..st.len())
         .map(|i| st.wall_penetration(i))
         .fold(f64::NEG_INFINITY, f64::max);
-    let aligned = aligned_fraction(st);
+    let has_rods = st.bodies.iter().any(|b| b.half_length > 0.0);
+    let walled = st.walls != magsep_systems::packing::walls::WallKind::Periodic;
+    let aligned = if has_rods && walled {
+        aligned_fraction(st)
+    } else {
+        f64::NAN
+    };
     let cubatic = if shape.is_superquadric() {
         cubatic_order(&st.orientations)
     } else {
@@ -94,7 +108,7 @@ pub struct Point {
     pub cubatic: Estimate,
 }
 
-/// `runs` seeds of one configuration, in parallel.
+/// `runs` seeds of one configuration (FIRE), in parallel.
 pub fn point(
     label: String,
     n: usize,
@@ -103,9 +117,30 @@ pub fn point(
     phi0: f64,
     runs: u64,
 ) -> Result<Point, BenchError> {
+    point_with(
+        label,
+        n,
+        shape,
+        container,
+        phi0,
+        runs,
+        OverlapRemovalScheme::Fire,
+    )
+}
+
+/// [`point`] with the overlap-removal `scheme`.
+pub fn point_with(
+    label: String,
+    n: usize,
+    shape: Shape,
+    container: &ContainerSpec,
+    phi0: f64,
+    runs: u64,
+    scheme: OverlapRemovalScheme,
+) -> Result<Point, BenchError> {
     let results: Vec<RunMeasures> = (1..=runs)
         .into_par_iter()
-        .map(|seed| measure(n, shape, container, phi0, seed))
+        .map(|seed| measure(n, shape, container, phi0, seed, scheme))
         .collect::<Result<_, _>>()?;
     let est = |f: fn(&RunMeasures) -> f64| {
         let v: Vec<f64> = results.iter().map(f).collect();

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde_json::json;
 
-use super::{Point, half_width, point, rod};
+use super::{Point, half_width, point, point_with, rod};
 use crate::bench::BenchError;
 use crate::chart::{Chart, Figure, Line, Series, Style, write_svg};
 use crate::scene::ContainerSpec;
@@ -31,34 +31,63 @@ fn sizes(quick: bool, n_full: usize, runs_full: u64) -> (usize, u64) {
 /// S against D_cyl / aspect, and the 1/D_cyl extrapolation of phi.
 pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;
-    let (n, runs) = sizes(quick, 200, 3);
-    let lambdas: Vec<f64> = if quick { vec![1.0, 3.0] } else { vec![1.0, 2.0, 3.0, 5.0] };
-    let diameters: Vec<f64> = if quick {
-        vec![1.5, 2.0, 3.0, 5.0]
+    let (n, runs) = sizes(quick, 120, 2);
+    let lambdas: Vec<f64> = if quick {
+        vec![1.0, 3.0]
     } else {
-        vec![1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0]
+        vec![1.0, 2.0, 3.0, 5.0]
     };
-    let mut phi_star = Chart::new("phi* = phi / phi_periodic").x_label("D_cyl / D").y_label("phi*");
+    let diameters: Vec<f64> = if quick {
+        vec![1.5, 2.0, 3.0, 4.0, 6.0]
+    } else {
+        vec![1.05, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 10.0]
+    };
+    let mut phi_star = Chart::new("phi* = phi / phi_periodic")
+        .x_label("D_cyl / D")
+        .y_label("phi*");
     let mut c_star = Chart::new("<C>* = (<C> - 2) / (<C>_periodic - 2)")
         .x_label("D_cyl / D")
         .y_label("<C>*");
-    let mut nem = Chart::new("nematic order").x_label("D_cyl / aspect ratio").y_label("S").x_log(true);
+    let mut nem = Chart::new("nematic order")
+        .x_label("D_cyl / aspect ratio")
+        .y_label("S")
+        .x_log(true);
     let mut extrap = Chart::new("phi against 1 / D_cyl (linear fit over D_cyl >= 3 D)")
         .x_label("D / D_cyl")
         .y_label("phi");
     let mut summary = Vec::new();
     for &l in &lambdas {
         let phi0 = 0.05;
-        let per = point(format!("aspect {l} periodic"), n, rod(l), &ContainerSpec::PeriodicBox {}, phi0, runs)?;
+        let per = point(
+            format!("aspect {l} periodic"),
+            n,
+            rod(l),
+            &ContainerSpec::PeriodicBox {},
+            phi0,
+            runs,
+        )?;
         let mut pts: Vec<(f64, Point)> = Vec::new();
         for &d in diameters.iter().filter(|d| **d > 1.0) {
             let spec = ContainerSpec::Cylinder { radius: 0.5 * d };
-            let p = point(format!("aspect {l} D_cyl {d}"), n, rod(l), &spec, phi0, runs)?;
+            let p = point(
+                format!("aspect {l} D_cyl {d}"),
+                n,
+                rod(l),
+                &spec,
+                phi0,
+                runs,
+            )?;
             pts.push((d, p));
         }
         let name = format!("aspect {l}");
-        let ps: Vec<(f64, f64)> = pts.iter().map(|(d, p)| (*d, rescaled_phi(p.phi.mean, per.phi.mean))).collect();
-        let pe: Vec<f64> = pts.iter().map(|(_, p)| half_width(&p.phi) / per.phi.mean).collect();
+        let ps: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|(d, p)| (*d, rescaled_phi(p.phi.mean, per.phi.mean)))
+            .collect();
+        let pe: Vec<f64> = pts
+            .iter()
+            .map(|(_, p)| half_width(&p.phi) / per.phi.mean)
+            .collect();
         phi_star = phi_star.series(Series::new(name.clone(), ps).y_err(pe));
         let cs: Vec<(f64, f64)> = pts
             .iter()
@@ -68,17 +97,42 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
         if l > 1.0 {
             nem = nem.series(Series::new(
                 name.clone(),
-                pts.iter().map(|(d, p)| (*d / l, p.nematic.mean)).collect::<Vec<_>>(),
+                pts.iter()
+                    .map(|(d, p)| (*d / l, p.nematic.mean))
+                    .collect::<Vec<_>>(),
             ));
         }
-        let (wd, wp): (Vec<f64>, Vec<f64>) =
-            pts.iter().filter(|(d, _)| *d >= 3.0).map(|(d, p)| (*d, p.phi.mean)).unzip();
+        let (wd, wp): (Vec<f64>, Vec<f64>) = pts
+            .iter()
+            .filter(|(d, _)| *d >= 3.0)
+            .map(|(d, p)| (*d, p.phi.mean))
+            .unzip();
         let fit = bulk_extrapolation(&wd, &wp).map_err(|e| {
-            BenchError::Runtime(format!("aspect {l}: 1/D_cyl fit: {e}"))
+            BenchError::Runtime(format!("aspect {l}: 1/D_cyl fit over D_cyl >= 3: {e}"))
         })?;
         extrap = extrap
-            .series(Series::new(name.clone(), pts.iter().map(|(d, p)| (1.0 / d, p.phi.mean)).collect::<Vec<_>>()).style(Style::Markers))
-            .line(Line::new(format!("{name}: fit, bulk {:.3} (periodic {:.3})", fit.intercept, per.phi.mean), vec![(0.0, fit.intercept), (1.0 / 3.0, fit.intercept + fit.slope / 3.0)]).dashed(true));
+            .series(
+                Series::new(
+                    name.clone(),
+                    pts.iter()
+                        .map(|(d, p)| (1.0 / d, p.phi.mean))
+                        .collect::<Vec<_>>(),
+                )
+                .style(Style::Markers),
+            )
+            .line(
+                Line::new(
+                    format!(
+                        "{name}: fit, bulk {:.3} (periodic {:.3})",
+                        fit.intercept, per.phi.mean
+                    ),
+                    vec![
+                        (0.0, fit.intercept),
+                        (1.0 / 3.0, fit.intercept + fit.slope / 3.0),
+                    ],
+                )
+                .dashed(true),
+            );
         summary.push(json!({
             "aspect_ratio": l,
             "periodic": per,
@@ -91,14 +145,22 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     nem = nem
         .line(Line::new("1.5", vec![(1.5, 0.0), (1.5, 1.0)]).dashed(true))
         .line(Line::new("0.75", vec![(0.75, 0.0), (0.75, 1.0)]).dashed(true));
-    let fig = Figure::new(format!("Spherocylinders in a hard cylinder, N = {n}, {runs} runs per point (95 % intervals)"), 2)
-        .panel(phi_star)
-        .panel(c_star)
-        .panel(nem)
-        .panel(extrap);
+    let fig = Figure::new(
+        format!(
+            "Spherocylinders in a hard cylinder, N = {n}, {runs} runs per point (95 % intervals)"
+        ),
+        2,
+    )
+    .panel(phi_star)
+    .panel(c_star)
+    .panel(nem)
+    .panel(extrap);
     let path = out.join("cylinder_confinement.svg");
     save(&path, &fig.to_svg(560.0, 420.0))?;
-    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary}));
+    println!(
+        "{}",
+        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary})
+    );
     Ok(())
 }
 
@@ -106,22 +168,44 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
 /// the wall-aligned fraction against the aspect ratio.
 pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;
-    let (n, runs) = sizes(quick, 200, 3);
+    let (n, runs) = sizes(quick, 120, 2);
     let deg = std::f64::consts::PI / 180.0;
-    let angles: Vec<f64> = if quick { vec![9.0, 45.0] } else { vec![9.0, 15.0, 30.0, 45.0] };
-    let lambdas: Vec<f64> = if quick { vec![1.0, 3.0] } else { vec![1.0, 1.25, 2.0, 3.0, 5.0] };
-    let ratios: Vec<f64> = if quick { vec![2.0] } else { vec![1.5, 3.0, 5.0] };
-    let mut phi_star = Chart::new("phi* = (phi - phi_min) / (phi_periodic - phi_min), alpha = 9 deg")
+    let angles: Vec<f64> = if quick {
+        vec![9.0, 45.0]
+    } else {
+        vec![9.0, 30.0, 45.0]
+    };
+    let lambdas: Vec<f64> = if quick {
+        vec![1.25, 3.0]
+    } else {
+        vec![1.25, 2.0, 3.0, 5.0]
+    };
+    let ratios: Vec<f64> = if quick {
+        vec![2.0]
+    } else {
+        vec![1.5, 3.0, 5.0]
+    };
+    let mut phi_star =
+        Chart::new("phi* = (phi - phi_min) / (phi_periodic - phi_min), alpha = 9 deg")
+            .x_label("l_w / l_w,min")
+            .y_label("phi*");
+    let mut c_star = Chart::new("<C>*, alpha = 9 deg")
         .x_label("l_w / l_w,min")
-        .y_label("phi*");
-    let mut c_star = Chart::new("<C>*, alpha = 9 deg").x_label("l_w / l_w,min").y_label("<C>*");
+        .y_label("<C>*");
     let mut align = Chart::new("wall-aligned fraction (4 deg, within 1 D), largest l_w")
         .x_label("aspect ratio")
         .y_label("f_align");
     let mut summary = Vec::new();
     let mut periodic = Vec::new();
     for &l in &lambdas {
-        periodic.push(point(format!("aspect {l} periodic"), n, rod(l), &ContainerSpec::PeriodicBox {}, 0.05, runs)?);
+        periodic.push(point(
+            format!("aspect {l} periodic"),
+            n,
+            rod(l),
+            &ContainerSpec::PeriodicBox {},
+            0.05,
+            runs,
+        )?);
     }
     for &a in &angles {
         let mut fa = Vec::new();
@@ -130,19 +214,38 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
             let phimin = wedge_min_packing_fraction(0.5, l - 1.0, a * deg);
             let mut pts = Vec::new();
             for &r in &ratios {
-                let spec = ContainerSpec::Wedge { angle: a * deg, length: r * lmin };
-                let p = point(format!("alpha {a} aspect {l} l/lmin {r}"), n, rod(l), &spec, 0.05, runs)?;
+                let spec = ContainerSpec::Wedge {
+                    angle: a * deg,
+                    length: r * lmin,
+                };
+                let p = point(
+                    format!("alpha {a} aspect {l} l/lmin {r}"),
+                    n,
+                    rod(l),
+                    &spec,
+                    0.05,
+                    runs,
+                )?;
                 pts.push((r, p));
             }
             if a == angles[0] {
                 let per = &periodic[k];
                 phi_star = phi_star.series(Series::new(
                     format!("aspect {l}"),
-                    pts.iter().map(|(r, p)| (*r, rescaled_packing_fraction_wedge(p.phi.mean, per.phi.mean, phimin))).collect::<Vec<_>>(),
+                    pts.iter()
+                        .map(|(r, p)| {
+                            (
+                                *r,
+                                rescaled_packing_fraction_wedge(p.phi.mean, per.phi.mean, phimin),
+                            )
+                        })
+                        .collect::<Vec<_>>(),
                 ));
                 c_star = c_star.series(Series::new(
                     format!("aspect {l}"),
-                    pts.iter().map(|(r, p)| (*r, rescaled_contacts(p.contacts.mean, per.contacts.mean))).collect::<Vec<_>>(),
+                    pts.iter()
+                        .map(|(r, p)| (*r, rescaled_contacts(p.contacts.mean, per.contacts.mean)))
+                        .collect::<Vec<_>>(),
                 ));
             }
             if let Some((_, p)) = pts.last() {
@@ -151,20 +254,29 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
             summary.push(json!({"angle_deg": a, "aspect_ratio": l, "l_w_min": lmin, "phi_l_w_min": phimin, "periodic": periodic[k], "points": pts.iter().map(|(r, p)| json!({"l_w_over_min": r, "point": p})).collect::<Vec<_>>()}));
         }
         align = align.series(
-            Series::new(format!("alpha = {a} deg"), fa.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>())
-                .y_err(fa.iter().map(|p| p.2).collect::<Vec<_>>()),
+            Series::new(
+                format!("alpha = {a} deg"),
+                fa.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+            )
+            .y_err(fa.iter().map(|p| p.2).collect::<Vec<_>>()),
         );
     }
     align = align
         .line(Line::new("thesis: 0.5 (aspect <= 2)", vec![(1.0, 0.5), (2.0, 0.5)]).dashed(true))
         .line(Line::new("thesis: > 0.8 (aspect >= 3)", vec![(3.0, 0.8), (5.0, 0.8)]).dashed(true));
-    let fig = Figure::new(format!("Spherocylinders in a hard wedge, N = {n}, {runs} runs per point"), 3)
-        .panel(phi_star)
-        .panel(c_star)
-        .panel(align);
+    let fig = Figure::new(
+        format!("Spherocylinders in a hard wedge, N = {n}, {runs} runs per point"),
+        3,
+    )
+    .panel(phi_star)
+    .panel(c_star)
+    .panel(align);
     let path = out.join("wedge_confinement.svg");
     save(&path, &fig.to_svg(520.0, 420.0))?;
-    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary}));
+    println!(
+        "{}",
+        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary})
+    );
     Ok(())
 }
 
@@ -172,47 +284,103 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
 /// the exponent, with the thesis's values.
 pub fn chart_superballs(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;
-    let (n, runs) = sizes(quick, 750, 2);
-    let exponents: Vec<f64> = if quick { vec![2.0, 3.0, 5.0] } else { vec![2.0, 2.25, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0] };
-    let mut pts = Vec::new();
+    let (n, runs) = if quick { (40, 1) } else { (60, 2) };
+    let exponents: Vec<f64> = if quick {
+        vec![2.0, 3.0]
+    } else {
+        vec![2.0, 2.5, 3.0, 4.0, 5.0]
+    };
+    let mut fire = Vec::new();
+    let mut revised = Vec::new();
     for &g in &exponents {
         let shape = magsep_components::shape::Shape::Superquadric {
             semi_axes: glam::DVec3::splat(0.5),
             exponents: glam::DVec3::splat(g),
         };
-        pts.push((g, point(format!("superball g = {g}"), n, shape, &ContainerSpec::PeriodicBox {}, 0.05, runs)?));
+        let cube = ContainerSpec::PeriodicBox {};
+        fire.push((
+            g,
+            point(
+                format!("superball g = {g}, FIRE"),
+                n,
+                shape,
+                &cube,
+                0.05,
+                runs,
+            )?,
+        ));
+        revised.push((
+            g,
+            point_with(
+                format!("superball g = {g}, revised"),
+                n,
+                shape,
+                &cube,
+                0.05,
+                runs,
+                super::Scheme::Revised,
+            )?,
+        ));
     }
-    let series = |f: fn(&Point) -> (f64, f64)| -> (Vec<(f64, f64)>, Vec<f64>) {
-        (pts.iter().map(|(g, p)| (*g, f(p).0)).collect(), pts.iter().map(|(_, p)| f(p).1).collect())
-    };
-    let (phi, phie) = series(|p| (p.phi.mean, half_width(&p.phi)));
-    let (c, ce) = series(|p| (p.contacts.mean, half_width(&p.contacts)));
-    let (s4, _) = series(|p| (p.cubatic.mean, half_width(&p.cubatic)));
-    let fig = Figure::new(format!("Superballs, N = {n}, periodic, {runs} runs per point"), 3)
-        .panel(
-            Chart::new("packing fraction")
-                .x_label("exponent g")
-                .y_label("phi")
-                .series(Series::new("magsep (FIRE)", phi).y_err(phie))
-                .line(Line::new("thesis, g = 2: 0.61", vec![(2.0, 0.61), (2.3, 0.61)]).dashed(true))
-                .line(Line::new("RCP 0.64", vec![(2.0, 0.64), (5.0, 0.64)]).dashed(true)),
-        )
-        .panel(
-            Chart::new("mean contact number")
-                .x_label("exponent g")
-                .y_label("<C> (extrapolated)")
-                .series(Series::new("magsep", c).y_err(ce))
-                .line(Line::new("thesis: 5.84 - 1.25 (g - 2)", vec![(2.0, 5.84), (5.0, 2.09)]).dashed(true)),
-        )
-        .panel(
-            Chart::new("cubatic order S_4")
-                .x_label("exponent g")
-                .y_label("S_4")
-                .series(Series::new("magsep", s4))
-                .line(Line::new("finite-size floor ~0.04 (N = 750)", vec![(2.0, 0.04), (5.0, 0.04)]).dashed(true)),
-        );
+    let series =
+        |pts: &[(f64, Point)], f: fn(&Point) -> (f64, f64)| -> (Vec<(f64, f64)>, Vec<f64>) {
+            (
+                pts.iter().map(|(g, p)| (*g, f(p).0)).collect(),
+                pts.iter().map(|(_, p)| f(p).1).collect(),
+            )
+        };
+    let (phi, phie) = series(&fire, |p| (p.phi.mean, half_width(&p.phi)));
+    let (c, ce) = series(&fire, |p| (p.contacts.mean, half_width(&p.contacts)));
+    let (s4, _) = series(&fire, |p| (p.cubatic.mean, half_width(&p.cubatic)));
+    let (rphi, _) = series(&revised, |p| (p.phi.mean, half_width(&p.phi)));
+    let (rc, _) = series(&revised, |p| (p.contacts.mean, half_width(&p.contacts)));
+    let (rs4, _) = series(&revised, |p| (p.cubatic.mean, half_width(&p.cubatic)));
+    let fig = Figure::new(
+        format!("Superballs, N = {n}, periodic, {runs} runs per point"),
+        3,
+    )
+    .panel(
+        Chart::new("packing fraction")
+            .x_label("exponent g")
+            .y_label("phi")
+            .series(Series::new("FIRE (jammed)", phi).y_err(phie))
+            .series(Series::new("revised, 200 N moves/step (thesis)", rphi).style(Style::Dashed))
+            .line(Line::new("thesis, g = 2: 0.61", vec![(2.0, 0.61), (2.3, 0.61)]).dashed(true))
+            .line(Line::new("RCP 0.64", vec![(2.0, 0.64), (5.0, 0.64)]).dashed(true)),
+    )
+    .panel(
+        Chart::new("mean contact number")
+            .x_label("exponent g")
+            .y_label("<C> (extrapolated)")
+            .series(Series::new("FIRE", c).y_err(ce))
+            .series(Series::new("revised (thesis)", rc).style(Style::Dashed))
+            .line(
+                Line::new(
+                    "thesis: 5.84 - 1.25 (g - 2)",
+                    vec![(2.0, 5.84), (5.0, 2.09)],
+                )
+                .dashed(true),
+            ),
+    )
+    .panel(
+        Chart::new("cubatic order S_4")
+            .x_label("exponent g")
+            .y_label("S_4")
+            .series(Series::new("FIRE", s4))
+            .series(Series::new("revised (thesis)", rs4).style(Style::Dashed))
+            .line(
+                Line::new(
+                    "isotropic floor ~0.04 (N = 750)",
+                    vec![(2.0, 0.04), (5.0, 0.04)],
+                )
+                .dashed(true),
+            ),
+    );
     let path = out.join("superballs.svg");
     save(&path, &fig.to_svg(520.0, 420.0))?;
-    println!("{}", json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "points": pts.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>()}));
+    println!(
+        "{}",
+        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "fire": fire.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>(), "revised": revised.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>()})
+    );
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Typed scene sections (serde, `deny_unknown_fields`, tagged enums). SI units.
 
-use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
 use glam::DVec3;
+use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
 use magsep_components::shape::Shape;
 use serde::{Deserialize, Serialize};
 

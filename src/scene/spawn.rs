@@ -97,7 +97,10 @@ fn spawn_packing_particles(scene: &Scene, world: &mut World, seed: u64) -> Resul
     let d = scene.reference_diameter();
     let bodies: Vec<Body> = shapes.iter().map(|s| Body::from_shape(s, d)).collect();
     let volume: f64 = bodies.iter().map(|b| b.volume).sum();
-    let spec = scene.container.clone().unwrap_or(ContainerSpec::PeriodicBox {});
+    let spec = scene
+        .container
+        .clone()
+        .unwrap_or(ContainerSpec::PeriodicBox {});
     let container = start_container(&spec, volume * d.powi(3), config.initial_packing_fraction);
     let mut rngs: Vec<_> = (0..shapes.len() as u64)
         .map(|i| particle_stream(seed, i))

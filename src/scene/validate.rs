@@ -103,7 +103,12 @@ fn typed_array<T: DeserializeOwned>(
     }
 }
 
-pub(super) fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl FnOnce() -> String) {
+pub(super) fn check(
+    errors: &mut Vec<SceneError>,
+    ok: bool,
+    path: &str,
+    message: impl FnOnce() -> String,
+) {
     if !ok {
         errors.push(SceneError::new(path, message()));
     }
@@ -165,7 +170,8 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             }
             "fibres" => fibres = typed_array::<FibreSpec>(value, "fibres", &mut errors),
             "fibre_packings" => {
-                fibre_packings = typed_array::<FibrePackingSpec>(value, "fibre_packings", &mut errors)
+                fibre_packings =
+                    typed_array::<FibrePackingSpec>(value, "fibre_packings", &mut errors)
             }
             "particles" => {
                 particles = typed_array::<ParticleGroup>(value, "particles", &mut errors)

@@ -116,14 +116,29 @@ fn wall_entity(walls: Walls, e: DVec3, entity: SceneEntity) -> SceneEntity {
         Walls::Wedge { .. } => {
             // faces: bottom (y = 0), back (x = e.x), slope (through the z axis), two triangles each
             let quads = [
-                [p3(0.0, 0.0, 0.0), p3(e.x, 0.0, 0.0), p3(e.x, 0.0, e.z), p3(0.0, 0.0, e.z)],
-                [p3(e.x, 0.0, 0.0), p3(e.x, e.y, 0.0), p3(e.x, e.y, e.z), p3(e.x, 0.0, e.z)],
-                [p3(0.0, 0.0, 0.0), p3(e.x, e.y, 0.0), p3(e.x, e.y, e.z), p3(0.0, 0.0, e.z)],
+                [
+                    p3(0.0, 0.0, 0.0),
+                    p3(e.x, 0.0, 0.0),
+                    p3(e.x, 0.0, e.z),
+                    p3(0.0, 0.0, e.z),
+                ],
+                [
+                    p3(e.x, 0.0, 0.0),
+                    p3(e.x, e.y, 0.0),
+                    p3(e.x, e.y, e.z),
+                    p3(e.x, 0.0, e.z),
+                ],
+                [
+                    p3(0.0, 0.0, 0.0),
+                    p3(e.x, e.y, 0.0),
+                    p3(e.x, e.y, e.z),
+                    p3(0.0, 0.0, e.z),
+                ],
             ];
             let mut points = Vec::with_capacity(18);
             for q in quads {
                 for k in [0, 1, 2, 0, 2, 3] {
-                    points.push(q[k].clone());
+                    points.push(q[k]);
                 }
             }
             SceneEntity {

@@ -369,7 +369,9 @@ fn record_scene_geometry_of_spheres_capsules_and_box() {
         ..frame.clone()
     };
     assert_eq!(
-        scene::scene_update(&unbounded, None, &Default::default(), 4).entities.len(),
+        scene::scene_update(&unbounded, None, &Default::default(), 4)
+            .entities
+            .len(),
         1
     );
     let p = &s.entities[0];

@@ -3,14 +3,14 @@
 use super::frame::FibreShape;
 use super::proto::{ParticleState, particle_count, state_schema};
 use super::scene::{SceneDecor, scene_update};
-use glam::DVec3;
-use magsep_components::container::Walls;
 use super::{
     METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
     SUMMARY_METADATA_NAME,
 };
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
+use glam::DVec3;
+use magsep_components::container::Walls;
 use mcap::records::{MessageHeader, Metadata};
 use std::collections::BTreeMap;
 use std::fs::File;

@@ -1,7 +1,7 @@
 //! Characterisation of packings: contact numbers, orientational order, pair correlation.
 
-pub mod contacts;
 pub mod confinement;
+pub mod contacts;
 pub mod cubatic;
 pub mod order;
 pub mod wall_order;

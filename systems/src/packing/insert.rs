@@ -70,8 +70,13 @@ pub fn random_insertion(
         let c = g.coords(p);
         ((c[0] as usize) * g.cells[1] + c[1] as usize) * g.cells[2] + c[2] as usize
     };
-    let k_img: [i64; 3] =
-        std::array::from_fn(|a| if periodic[a] { (cutoff / edges[a]).ceil() as i64 } else { 0 });
+    let k_img: [i64; 3] = std::array::from_fn(|a| {
+        if periodic[a] {
+            (cutoff / edges[a]).ceil() as i64
+        } else {
+            0
+        }
+    });
     let images = || {
         (-k_img[0]..=k_img[0]).flat_map(move |a| {
             (-k_img[1]..=k_img[1]).flat_map(move |b| {

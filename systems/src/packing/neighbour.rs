@@ -293,8 +293,7 @@ impl NeighbourList {
                                 if i == j && (a, b, c) <= (0, 0, 0) {
                                     continue; // self: only one of each +n / -n pair
                                 }
-                                let shift =
-                                    DVec3::new(a as f64, b as f64, c as f64) * state.edges;
+                                let shift = DVec3::new(a as f64, b as f64, c as f64) * state.edges;
                                 test(i, j, shift, &mut pairs);
                             }
                         }

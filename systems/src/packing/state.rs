@@ -287,7 +287,10 @@ impl PackingState {
                 let mut wc: Vec<WallContact> = Vec::new();
                 let support = |d: DVec3| b.support(q, d);
                 walls::convex_wall_contacts(self.walls, self.edges, x, &support, margin, &mut wc);
-                out.extend(wc.iter().map(|w| PairContact::wall(w.overlap, w.normal, w.rc)));
+                out.extend(
+                    wc.iter()
+                        .map(|w| PairContact::wall(w.overlap, w.normal, w.rc)),
+                );
             }
         }
     }
@@ -335,14 +338,7 @@ impl PackingState {
 }
 
 /// Contact of body `a` at (`xa`, `qa`) with body `b` at (`xb`, `qb`).
-pub fn body_contact(
-    a: &Body,
-    xa: DVec3,
-    qa: DQuat,
-    b: &Body,
-    xb: DVec3,
-    qb: DQuat,
-) -> PairContact {
+pub fn body_contact(a: &Body, xa: DVec3, qa: DQuat, b: &Body, xb: DVec3, qb: DQuat) -> PairContact {
     match (a.kind, b.kind) {
         (BodyKind::Rod, BodyKind::Rod) => pair_contact(
             qa * DVec3::Z,

@@ -296,8 +296,7 @@ pub fn observe_packing(
         nematic_order: nematic_order(&rod_axes),
         max_overlap: cn.max_overlap * d,
         contact_histogram: cn.histogram,
-        wall_aligned_fraction: (walled && !rod_axes.is_empty())
-            .then(|| aligned_fraction(&state)),
+        wall_aligned_fraction: (walled && !rod_axes.is_empty()).then(|| aligned_fraction(&state)),
         cubatic_order: (!sq.is_empty()).then(|| cubatic_order(&sq)),
         max_wall_penetration,
         computed: true,
