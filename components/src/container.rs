@@ -85,11 +85,11 @@ impl Container {
 /// One face of a hard-wall container, spawned as a boundary entity (its geometry follows the
 /// [`Container`] resource, which compression changes).
 #[derive(
-    bevy_ecs::prelude::Component, Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize,
+    bevy_ecs::prelude::Component, Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize,
 )]
 pub enum WallFace {
     /// The cylinder's lateral wall.
-    CylinderWall,
+    Cylinder,
     /// The wedge's bottom plane y = 0.
     WedgeBottom,
     /// The wedge's back plane x = edges.x.
@@ -118,7 +118,7 @@ impl Walls {
     /// ```
     pub fn faces(&self) -> Vec<WallFace> {
         match self {
-            Walls::Cylinder => vec![WallFace::CylinderWall],
+            Walls::Cylinder => vec![WallFace::Cylinder],
             Walls::Wedge { .. } => vec![
                 WallFace::WedgeBottom,
                 WallFace::WedgeBack,

@@ -6,12 +6,13 @@ use serde_json::json;
 
 use super::{Point, half_width, point, point_with, rod};
 use crate::bench::BenchError;
-use crate::chart::{Chart, Figure, Line, Series, Style, write_svg};
+use crate::chart::{Chart, Figure, Heatmap, Line, Series, Style, write_svg};
 use crate::scene::ContainerSpec;
 use magsep_systems::analysis::confinement::{
     bulk_extrapolation, rescaled_contact_number as rescaled_contacts,
     rescaled_packing_fraction as rescaled_phi, rescaled_packing_fraction_wedge,
 };
+use magsep_systems::analysis::wall_order::orientation_histogram;
 use magsep_systems::packing::walls::{wedge_min_length, wedge_min_packing_fraction};
 
 fn save(path: &Path, svg: &str) -> Result<(), BenchError> {
@@ -40,7 +41,7 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     let diameters: Vec<f64> = if quick {
         vec![1.5, 2.0, 3.0, 4.0, 6.0]
     } else {
-        vec![1.05, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 10.0]
+        vec![1.05, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 10.0]
     };
     let mut phi_star = Chart::new("phi* = phi / phi_periodic")
         .x_label("D_cyl / D")
@@ -67,7 +68,11 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
             runs,
         )?;
         let mut pts: Vec<(f64, Point)> = Vec::new();
-        for &d in diameters.iter().filter(|d| **d > 1.0) {
+        // random insertion needs room to turn: rods start at D_cyl >= 1.25 D
+        for &d in diameters
+            .iter()
+            .filter(|d| **d > 1.0 && (l == 1.0 || **d >= 1.25))
+        {
             let spec = ContainerSpec::Cylinder { radius: 0.5 * d };
             let p = point(
                 format!("aspect {l} D_cyl {d}"),
@@ -273,11 +278,54 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     .panel(align);
     let path = out.join("wedge_confinement.svg");
     save(&path, &fig.to_svg(520.0, 420.0))?;
+    let (hpath, histogram) =
+        orientation_map(out, n, angles[0] * deg, *ratios.last().unwrap_or(&3.0))?;
     println!(
         "{}",
-        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary})
+        json!({"charts": [path.display().to_string(), hpath.display().to_string()], "particles": n, "runs": runs, "sweeps": summary, "orientation_density": histogram})
     );
     Ok(())
+}
+
+/// Fig. 2.15: the orientation density of aspect-3 rods in the wedge of angle `alpha` [rad]
+/// and length `ratio` l_w,min (one run, seed 1).
+fn orientation_map(
+    out: &Path,
+    n: usize,
+    alpha: f64,
+    ratio: f64,
+) -> Result<(std::path::PathBuf, serde_json::Value), BenchError> {
+    let l = 3.0;
+    let spec = ContainerSpec::Wedge {
+        angle: alpha,
+        length: ratio * wedge_min_length(0.5, l - 1.0, alpha),
+    };
+    let mut cfg = magsep_components::packing::PackingConfig::defaults_for(n, 1.0);
+    cfg.initial_packing_fraction = 0.05;
+    let run = crate::bench::packing_run_in(n, rod(l), &cfg, 1, f64::INFINITY, &spec)?;
+    let axes: Vec<glam::DVec3> = (0..run.state.len()).map(|i| run.state.axis(i)).collect();
+    let h = orientation_histogram(&axes, 10, 9);
+    let d = h.density();
+    let pb = h.phi_bins();
+    let rows: Vec<Vec<f64>> = (0..d.len() / pb)
+        .map(|i| d[i * pb..(i + 1) * pb].to_vec())
+        .collect();
+    let deg = alpha.to_degrees();
+    let map = Heatmap::new(
+        format!("Orientation density, aspect 3, alpha = {deg:.0} deg, l_w = {ratio} l_w,min (1 = isotropic)"),
+        (0.0, 90.0),
+        (0.0, 1.0),
+        rows,
+    )
+    .x_label("azimuth phi from x in the xy plane [deg]")
+    .y_label("cos theta from the periodic axis z")
+    .colour_label("density");
+    let path = out.join("wedge_orientations.svg");
+    save(&path, &map.to_svg(640.0, 480.0))?;
+    Ok((
+        path,
+        json!({"aspect_ratio": l, "angle_deg": deg, "cos_theta_edges": h.cos_theta_edges, "phi_edges_rad": h.phi_edges, "counts": h.counts}),
+    ))
 }
 
 /// Superballs (thesis figs. 4.5-4.6; spec 10.4): phi, <C>, S_4 and the nematic order against

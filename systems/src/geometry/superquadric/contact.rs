@@ -334,6 +334,22 @@ pub fn contact(
             warm,
         }
     };
+    // a converged, accepted Newton solution (also the pair's next warm start)
+    let converged = |nw: &newton::Newton, overlap: f64, u: DVec3, iterations| {
+        let ws = WarmStart {
+            s_a: nw.s_a,
+            s_b: nw.s_b,
+        };
+        done(
+            overlap,
+            u,
+            nw.s_a,
+            nw.s_b,
+            ContactStatus::Converged,
+            iterations,
+            Some(ws),
+        )
+    };
     let mut iterations = 0;
     if opts.polish
         && let Some(w) = warm.filter(|w| w.s_a.is_finite() && w.s_b.is_finite())
@@ -341,19 +357,7 @@ pub fn contact(
         let nw = newton::solve(&s.pa, &s.pb, &s.pair, w.s_a, w.s_b, &set);
         iterations += nw.iterations;
         if let Some((overlap, u)) = accept(&s, &nw, bounds, None, slack, tol) {
-            let ws = WarmStart {
-                s_a: nw.s_a,
-                s_b: nw.s_b,
-            };
-            return done(
-                overlap,
-                u,
-                nw.s_a,
-                nw.s_b,
-                ContactStatus::Converged,
-                iterations,
-                Some(ws),
-            );
+            return converged(&nw, overlap, u, iterations);
         }
     }
     let d_a = s.qa.conjugate() * s.d;
@@ -402,19 +406,7 @@ pub fn contact(
     let nw = newton::solve(&s.pa, &s.pb, &s.pair, seed.s_a, seed.s_b, &set);
     iterations += nw.iterations;
     if let Some((overlap, u)) = accept(&s, &nw, bounds, upper, slack, tol) {
-        let ws = WarmStart {
-            s_a: nw.s_a,
-            s_b: nw.s_b,
-        };
-        return done(
-            overlap,
-            u,
-            nw.s_a,
-            nw.s_b,
-            ContactStatus::Converged,
-            iterations,
-            Some(ws),
-        );
+        return converged(&nw, overlap, u, iterations);
     }
     // retry once from the centre line
     let centre = d_a.try_normalize().unwrap_or(DVec3::X);
@@ -422,19 +414,7 @@ pub fn contact(
     let nw = newton::solve(&s.pa, &s.pb, &s.pair, s_a, s_b, &set);
     iterations += nw.iterations;
     if let Some((overlap, u)) = accept(&s, &nw, bounds, upper, slack, tol) {
-        let ws = WarmStart {
-            s_a: nw.s_a,
-            s_b: nw.s_b,
-        };
-        return done(
-            overlap,
-            u,
-            nw.s_a,
-            nw.s_b,
-            ContactStatus::Converged,
-            iterations,
-            Some(ws),
-        );
+        return converged(&nw, overlap, u, iterations);
     }
     seed_result(ContactStatus::Fallback, iterations)
 }

@@ -133,28 +133,8 @@ pub enum WallKind {
     Box,
 }
 
-/// One wall of a container (same variants as the scene's wall faces).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum WallId {
-    /// The cylinder's lateral wall.
-    Cylinder,
-    /// The wedge's bottom plane y = 0.
-    WedgeBottom,
-    /// The wedge's back plane x = edges.x.
-    WedgeBack,
-    /// The wedge's slope plane y = x tan(alpha).
-    WedgeSlope,
-    /// The face where coordinate `axis` (0 = x, 1 = y, 2 = z) is 0 (slab, box).
-    Low {
-        /// Axis index.
-        axis: u8,
-    },
-    /// The face where coordinate `axis` equals `edges[axis]` (slab, box).
-    High {
-        /// Axis index.
-        axis: u8,
-    },
-}
+/// One wall of a container: the boundary entities' [`WallFace`](magsep_components::container::WallFace).
+pub use magsep_components::container::WallFace as WallId;
 
 /// A flat wall: points with `normal . x = offset`; the container is `normal . x < offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
