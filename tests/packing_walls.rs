@@ -256,3 +256,44 @@ placement = {{ kind = "box", min = [20.0, 20.0, 20.0], max = [21.0, 21.0, 21.0] 
     let e = parse_scene(&missing, &Default::default()).unwrap_err();
     assert!(e.to_string().contains("fibre_packings[0].recording"), "{e}");
 }
+
+/// Release tier: the thesis's cylinder-confinement trends (spec packing.md 10.2) at reduced
+/// size (N = 80, one seed; `magsep chart cylinder` runs the full sweep).
+#[test]
+#[ignore = "validation tier: run with --release -- --ignored"]
+fn cylinder_confinement_reproduces_the_thesis_trends() {
+    use magsep::packing_charts::{measure, rod};
+    use magsep::scene::ContainerSpec;
+    let fire = magsep::packing_charts::Scheme::Fire;
+    let run = |l: f64, d: Option<f64>| {
+        let spec = match d {
+            Some(d) => ContainerSpec::Cylinder { radius: 0.5 * d },
+            None => ContainerSpec::PeriodicBox {},
+        };
+        measure(80, rod(l), &spec, 0.05, 1, fire).unwrap()
+    };
+    // spheres: a minimum of phi near D_cyl = 2 D, phi* -> 1 for wide columns, single file <C> = 2
+    let periodic = run(1.0, None);
+    let sweep: Vec<(f64, f64)> = [1.5, 2.0, 3.0, 6.0, 10.0]
+        .iter()
+        .map(|&d| (d, run(1.0, Some(d)).phi))
+        .collect();
+    let (d_min, _) = sweep
+        .iter()
+        .copied()
+        .fold((0.0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    assert!(
+        (1.5..=2.5).contains(&d_min),
+        "minimum at {d_min}: {sweep:?}"
+    );
+    let wide = sweep.last().unwrap().1 / periodic.phi;
+    assert!((0.85..=1.02).contains(&wide), "phi* at D_cyl = 10: {wide}");
+    assert!(run(1.0, Some(1.5)).contacts <= 2.05);
+    // aspect 5: nematic below D_cyl = 0.75 aspect, isotropic above 1.5 aspect
+    let narrow = run(5.0, Some(2.5)).nematic;
+    let broad = run(5.0, Some(7.5)).nematic;
+    assert!(
+        narrow > 0.8 && broad < 0.3,
+        "S {narrow} at 0.5 aspect, {broad} at 1.5 aspect"
+    );
+}
