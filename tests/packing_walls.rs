@@ -258,7 +258,7 @@ placement = {{ kind = "box", min = [20.0, 20.0, 20.0], max = [21.0, 21.0, 21.0] 
 }
 
 /// Release tier: the thesis's cylinder-confinement trends (spec packing.md 10.2) at reduced
-/// size (N = 80, one seed; `magsep chart cylinder` runs the full sweep).
+/// size (N = 80, or more so that the column ends >= 3 particle lengths long; one seed; `magsep chart cylinder` runs the full sweep).
 #[test]
 #[ignore = "validation tier: run with --release -- --ignored"]
 fn cylinder_confinement_reproduces_the_thesis_trends() {
@@ -270,7 +270,8 @@ fn cylinder_confinement_reproduces_the_thesis_trends() {
             Some(d) => ContainerSpec::Cylinder { radius: 0.5 * d },
             None => ContainerSpec::PeriodicBox {},
         };
-        measure(80, rod(l), &spec, 0.05, 1, fire).unwrap()
+        let n = magsep::packing_charts::particles_for(&spec, rod(l), 80);
+        measure(n, rod(l), &spec, 0.05, 1, fire).unwrap()
     };
     // spheres: a minimum of phi near D_cyl = 2 D, phi* -> 1 for wide columns, single file <C> = 2
     let periodic = run(1.0, None);

@@ -128,6 +128,26 @@ pub fn point(
     )
 }
 
+/// Largest particle count the sweeps use.
+pub const MAX_PARTICLES: usize = 800;
+
+/// The particle count for `container`: at least `n`, and enough that the compressed (periodic)
+/// length ends near three particle lengths at phi ~ 0.55 (the thesis raised N for the same
+/// reason, F20: a compressed axis shorter than a particle makes a quasi-2-D, artificially
+/// jammed layer), at most [`MAX_PARTICLES`].
+pub fn particles_for(container: &ContainerSpec, shape: Shape, n: usize) -> usize {
+    let area = match *container {
+        ContainerSpec::Cylinder { radius } => std::f64::consts::PI * radius * radius,
+        ContainerSpec::Wedge { angle, length } => 0.5 * length * length * angle.tan(),
+        ContainerSpec::Slab { side } => side * side,
+        ContainerSpec::PeriodicBox {} | ContainerSpec::ClosedBox {} => return n,
+    };
+    let length = 2.0 * magsep_systems::geometry::bounding_radius(&shape);
+    let volume = magsep_systems::geometry::volume(&shape);
+    let needed = (3.0 * length * area * 0.55 / volume).ceil() as usize;
+    n.max(needed).min(MAX_PARTICLES)
+}
+
 /// [`point`] with the overlap-removal `scheme`.
 pub fn point_with(
     label: String,
@@ -138,6 +158,8 @@ pub fn point_with(
     runs: u64,
     scheme: OverlapRemovalScheme,
 ) -> Result<Point, BenchError> {
+    let n = particles_for(container, shape, n);
+    let label = format!("{label} (N = {n})");
     let results: Vec<RunMeasures> = (1..=runs)
         .into_par_iter()
         .map(|seed| measure(n, shape, container, phi0, seed, scheme))

@@ -152,7 +152,7 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
         .line(Line::new("0.75", vec![(0.75, 0.0), (0.75, 1.0)]).dashed(true));
     let fig = Figure::new(
         format!(
-            "Spherocylinders in a hard cylinder, N = {n}, {runs} runs per point (95 % intervals)"
+            "Spherocylinders in a hard cylinder, N = {n} or more (final length >= 3 particle lengths), {runs} runs per point (95 % intervals)"
         ),
         2,
     )
@@ -270,7 +270,7 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
         .line(Line::new("thesis: 0.5 (aspect <= 2)", vec![(1.0, 0.5), (2.0, 0.5)]).dashed(true))
         .line(Line::new("thesis: > 0.8 (aspect >= 3)", vec![(3.0, 0.8), (5.0, 0.8)]).dashed(true));
     let fig = Figure::new(
-        format!("Spherocylinders in a hard wedge, N = {n}, {runs} runs per point"),
+        format!("Spherocylinders in a hard wedge, N = {n} or more (final width >= 3 particle lengths), {runs} runs per point"),
         3,
     )
     .panel(phi_star)
@@ -302,6 +302,7 @@ fn orientation_map(
     };
     let mut cfg = magsep_components::packing::PackingConfig::defaults_for(n, 1.0);
     cfg.initial_packing_fraction = 0.05;
+    let n = super::particles_for(&spec, rod(l), n);
     let run = crate::bench::packing_run_in(n, rod(l), &cfg, 1, f64::INFINITY, &spec)?;
     let axes: Vec<glam::DVec3> = (0..run.state.len()).map(|i| run.state.axis(i)).collect();
     let h = orientation_histogram(&axes, 10, 9);
