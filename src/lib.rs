@@ -20,6 +20,7 @@ pub mod brownian;
 pub mod chart;
 pub mod fieldtool;
 pub mod packing_charts;
+pub mod particle_fluid;
 pub mod replay;
 pub mod scene;
 pub mod sim;

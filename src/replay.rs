@@ -145,6 +145,11 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
         let summary = crate::brownian::replay::replay_brownian(&rec, &scene, meta.seed)?;
         return Ok((summary, rec));
     }
+    if scene.particle_fluid.is_some() {
+        let summary =
+            crate::particle_fluid::replay::replay_particle_fluid(&rec, &scene, meta.seed)?;
+        return Ok((summary, rec));
+    }
     let frame = last_frame(&rec)?;
     let mut app = SimApp::new();
     app.world.insert_resource(scene.packing_config());

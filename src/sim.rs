@@ -9,6 +9,7 @@ use magsep_plugins::app::SimApp;
 use magsep_plugins::brownian::brownian_pipeline;
 use magsep_plugins::group::PipelineGroup;
 use magsep_plugins::packing::packing_pipeline;
+use magsep_plugins::particle_fluid::particle_fluid_pipeline;
 use magsep_plugins::record::{FibreShape, RecordError, RecordingMetadata, RecordingWriter};
 use magsep_plugins::recorder::Recorder;
 
@@ -93,13 +94,22 @@ impl Simulation {
                 .map_err(|e| SimError::Resume(e.to_string()))?;
         }
         let brownian = scene.brownian_section().is_some();
-        let pipeline = if brownian { "brownian" } else { "packing" };
-        let group = options.pipeline.clone().unwrap_or_else(|| {
-            if brownian {
-                brownian_pipeline()
-            } else {
-                packing_pipeline()
-            }
+        let pipeline = if brownian {
+            "brownian"
+        } else if scene.particle_fluid.is_some() {
+            "particle_fluid"
+        } else {
+            "packing"
+        };
+        let group = options.pipeline.clone().unwrap_or_else(|| match pipeline {
+            "brownian" => brownian_pipeline(),
+            "particle_fluid" => particle_fluid_pipeline(
+                scene
+                    .particle_fluid
+                    .as_ref()
+                    .is_some_and(|pf| pf.section.terms.collisions),
+            ),
+            _ => packing_pipeline(),
         });
         group.build(&mut app);
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
@@ -181,6 +191,13 @@ impl Simulation {
         if let Some(c) = self.app.world.get_resource::<BrownianConfig>() {
             return self.app.world.resource::<StepClock>().step >= c.steps;
         }
+        if let Some(c) = self
+            .app
+            .world
+            .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
+        {
+            return self.app.world.resource::<StepClock>().step >= c.steps;
+        }
         self.app
             .world
             .get_resource::<PackingStatus>()
@@ -211,6 +228,13 @@ impl Simulation {
 
     /// The JSON summary of the current state.
     pub fn summary(&self) -> serde_json::Value {
+        if self.pipeline == "particle_fluid" {
+            return crate::particle_fluid::run_summary(
+                &self.app.world,
+                self.seed,
+                self.started.elapsed().as_secs_f64(),
+            );
+        }
         if self.pipeline == "brownian" {
             return crate::brownian::run_summary(
                 &self.app.world,

@@ -5,8 +5,6 @@ use bevy_ecs::prelude::*;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use crate::forces::ForceContribution;
-
 /// Boltzmann constant k_B [J/K].
 pub const BOLTZMANN: f64 = 1.380_649e-23;
 
@@ -72,32 +70,15 @@ pub fn langevin(x: f64) -> f64 {
     }
 }
 
-macro_rules! contribution {
-    ($(#[$doc:meta])* $name:ident) => {
-        $(#[$doc])*
-        #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
-        pub struct $name(pub DVec3);
-
-        impl ForceContribution for $name {
-            fn force(&self) -> DVec3 {
-                self.0
-            }
-            fn clear(&mut self) {
-                self.0 = DVec3::ZERO;
-            }
-        }
-    };
-}
-
-contribution!(
+crate::force_contribution!(
     /// Force of the applied field and the fibres on the particle's moment, `|m| ∇|B|` [N].
     FieldForce
 );
-contribution!(
+crate::force_contribution!(
     /// Sum of dipole-dipole forces from the other particles within the cut-off [N].
     DipoleForce
 );
-contribution!(
+crate::force_contribution!(
     /// Soft-core (Mie) contact force from the other particles [N].
     ContactForce
 );

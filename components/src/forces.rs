@@ -46,3 +46,37 @@ pub struct NetForce(pub DVec3);
 /// Sum of all registered torque contributions [N m].
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NetTorque(pub DVec3);
+
+/// Define a force contribution component: a newtype around a force [N] implementing
+/// [`ForceContribution`] (used by the built-in contributions).
+///
+/// ```
+/// use glam::DVec3;
+/// use magsep_components::force_contribution;
+/// use magsep_components::forces::ForceContribution;
+/// force_contribution!(
+///     /// A test force [N].
+///     TestForce
+/// );
+/// let mut f = TestForce(DVec3::X);
+/// f.clear();
+/// assert_eq!(f.force(), DVec3::ZERO);
+/// ```
+#[macro_export]
+macro_rules! force_contribution {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(bevy_ecs::prelude::Component, Debug, Default, Clone, Copy, PartialEq,
+            serde::Serialize, serde::Deserialize)]
+        pub struct $name(pub glam::DVec3);
+
+        impl $crate::forces::ForceContribution for $name {
+            fn force(&self) -> glam::DVec3 {
+                self.0
+            }
+            fn clear(&mut self) {
+                self.0 = glam::DVec3::ZERO;
+            }
+        }
+    };
+}

@@ -16,6 +16,7 @@ pub mod brownian;
 pub mod clock;
 pub mod container;
 pub mod fibre;
+pub mod fluid;
 pub mod forces;
 pub mod health;
 pub mod packing;
@@ -32,6 +33,11 @@ pub mod prelude {
     pub use crate::clock::StepClock;
     pub use crate::container::{Container, Walls};
     pub use crate::fibre::{ExternalField, Fibre, FibreId};
+    pub use crate::fluid::{
+        AngularVelocity, BuoyancyForce, DragForce, FluidSample, GravityForce, HistoryForce,
+        InertialBody, Levitation, MagneticBuoyancyForce, ParticleFluidStats, RotationalDragTorque,
+        UndisturbedFlowForce, Velocity,
+    };
     pub use crate::forces::{ForceContribution, NetForce, NetTorque};
     pub use crate::health::Health;
     pub use crate::packing::{

@@ -8,6 +8,7 @@
 //! * [`core`]: clock and health.
 //! * [`packing`]: the `packing` pipeline.
 //! * [`brownian`]: the `brownian` pipeline.
+//! * [`particle_fluid`]: the `particle_fluid` pipeline (inertial particles in magnetised liquids).
 //! * [`recorder`] and [`record`]: recordings.
 
 #![warn(missing_docs)]
@@ -17,6 +18,7 @@ pub mod brownian;
 pub mod core;
 pub mod group;
 pub mod packing;
+pub mod particle_fluid;
 pub mod record;
 pub mod recorder;
 

@@ -116,6 +116,18 @@ pub enum PlacementSpec {
         /// Centres [m].
         positions: Vec<[f64; 3]>,
     },
+    /// Density-separation injection (particle_fluid; thesis 002 §2.5.3): particles denser than
+    /// the liquid start in the `heavy` height band, lighter ones in the `light` band, except a
+    /// fraction `impurity` of each that starts in the other band; uniform over the container's
+    /// x and y, without overlap.
+    Injection {
+        /// [z_min, z_max] of the heavy particles' band [m].
+        heavy: [f64; 2],
+        /// [z_min, z_max] of the light particles' band [m].
+        light: [f64; 2],
+        /// Imp: fraction of each kind in the wrong band (0: pre-separated, 0.5: random).
+        impurity: f64,
+    },
 }
 
 impl BrownianSection {
@@ -182,7 +194,7 @@ impl PlacementSpec {
                 let (r0, r1) = (r + gap, r + gap + thickness);
                 PI * (r1 * r1 - r0 * r0) * 2.0 * h
             }),
-            Self::Points { .. } => None,
+            Self::Points { .. } | Self::Injection { .. } => None,
         }
     }
 }
@@ -371,6 +383,10 @@ pub fn validate_group(
                 ));
             }
         }
+        PlacementSpec::Injection { .. } => errors.push(SceneError::new(
+            format!("{q}.kind"),
+            "injection is for the particle_fluid pipeline",
+        )),
         PlacementSpec::Points { positions } => {
             if positions.len() as u64 != count {
                 errors.push(SceneError::new(

@@ -21,7 +21,9 @@ mod brownian;
 mod brownian_tests;
 mod fibre_packing;
 mod fibres;
+mod fluid_spawn;
 pub mod packing_geometry;
+pub mod particle_fluid;
 mod placement;
 mod sections;
 mod spawn;
@@ -145,6 +147,9 @@ pub struct Scene {
     pub record: Option<RecordSection>,
     /// `[brownian]` (the brownian pipeline).
     pub brownian: Option<BrownianSection>,
+    /// `[particle_fluid]`, `[liquid]`, `[magnet]`, `[collisions]` and the container of the
+    /// particle_fluid pipeline.
+    pub particle_fluid: Option<particle_fluid::ParticleFluidScene>,
     /// Plugin kinds: (key, value) in file order.
     pub extensions: Vec<(String, toml::Value)>,
 }
@@ -160,6 +165,10 @@ pub const CORE_KEYS: &[&str] = &[
     "fibre_packings",
     "external_field",
     "brownian",
+    "particle_fluid",
+    "liquid",
+    "magnet",
+    "collisions",
 ];
 
 /// Parse and validate a scene; every problem is reported.

@@ -50,6 +50,8 @@ fn sample(
             f.center + axis * z + (u * t.cos() + v * t.sin()) * r
         }
         PlacementSpec::Points { positions } => DVec3::from_array(positions[k]),
+        // rejected by validation for brownian scenes
+        PlacementSpec::Injection { .. } => DVec3::ZERO,
     }
 }
 

@@ -15,6 +15,8 @@ pub enum PipelineKind {
     Packing,
     /// Brownian dynamics of magnetic nanoparticles around magnetised fibres.
     Brownian,
+    /// Inertial particles in a magnetised liquid (density separation), one-way coupled.
+    ParticleFluid,
 }
 
 /// `[simulation]`.
@@ -136,16 +138,30 @@ impl ShapeSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParticleGroup {
-    /// Number of particles. Range: >= 1.
+    /// Number of particles. Range: >= 1 (particle_fluid: or give `volume_fraction`).
+    #[serde(default)]
     pub count: u64,
     /// Shape.
     pub shape: ShapeSpec,
     /// Magnetic moment law (brownian pipeline). Default: non-magnetic.
     #[serde(default)]
     pub moment: Option<magsep_components::brownian::MomentModel>,
-    /// Start region (brownian pipeline; required there).
+    /// Start region (brownian and particle_fluid pipelines; required there).
     #[serde(default)]
     pub placement: Option<super::brownian::PlacementSpec>,
+    /// Particle density ρ_p [kg/m³] (particle_fluid).
+    #[serde(default)]
+    pub density: Option<f64>,
+    /// Evenly spaced density ratios ρ_p/ρ_f instead of one `density` (particle_fluid).
+    #[serde(default)]
+    pub density_ratios: Option<super::particle_fluid::DensityRatios>,
+    /// Initial velocity [m/s] (particle_fluid). Default zero.
+    #[serde(default)]
+    pub velocity: Option<[f64; 3]>,
+    /// Volume fraction Φ of the container instead of `count`: count = floor(Φ V / V_p)
+    /// (particle_fluid).
+    #[serde(default)]
+    pub volume_fraction: Option<f64>,
 }
 
 /// `[packing]`: every key optional (see `PackingConfig` for meanings and defaults).

@@ -55,6 +55,8 @@ pub fn spawn_scene_with(
 ) -> Result<(), SpawnError> {
     if let Some(section) = scene.brownian_section() {
         super::placement::spawn_brownian(scene, section, world, seed)?;
+    } else if let Some(pf) = &scene.particle_fluid {
+        super::fluid_spawn::spawn_particle_fluid(scene, pf, world, seed)?;
     } else {
         spawn_packing_particles(scene, world, seed)?;
     }

@@ -5,6 +5,10 @@ use serde::de::DeserializeOwned;
 use super::brownian::{BrownianSection, validate_group, validate_section};
 use super::fibre_packing::FibrePackingSpec;
 use super::fibres::{ExternalFieldSection, FibreSpec, validate_fibres};
+use super::particle_fluid::{
+    CollisionsSection, FluidContainerSpec, LiquidSection, MagnetSection, ParticleFluidScene,
+    ParticleFluidSection,
+};
 use super::sections::*;
 use super::{CORE_KEYS, Scene, SceneError, SceneRegistry};
 
@@ -154,12 +158,33 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut fibre_packings = Vec::new();
     let mut external_field = None;
     let mut brownian = None;
+    let mut pf_section = None;
+    let mut liquid = None;
+    let mut magnet = None;
+    let mut collisions = None;
+    let is_pf = table
+        .get("simulation")
+        .and_then(|s| s.get("pipeline"))
+        .and_then(|p| p.as_str())
+        == Some("particle_fluid");
+    let mut fluid_container = None;
     for (key, value) in &table {
         match key.as_str() {
             "simulation" => {
                 simulation = typed::<SimulationSection>(value, "simulation", &mut errors)
             }
+            "container" if is_pf => {
+                fluid_container = typed::<FluidContainerSpec>(value, "container", &mut errors)
+            }
             "container" => container = typed::<ContainerSpec>(value, "container", &mut errors),
+            "particle_fluid" => {
+                pf_section = typed::<ParticleFluidSection>(value, "particle_fluid", &mut errors)
+            }
+            "liquid" => liquid = typed::<LiquidSection>(value, "liquid", &mut errors),
+            "magnet" => magnet = typed::<MagnetSection>(value, "magnet", &mut errors),
+            "collisions" => {
+                collisions = typed::<CollisionsSection>(value, "collisions", &mut errors)
+            }
             "packing" => {
                 packing = typed::<PackingSection>(value, "packing", &mut errors).unwrap_or_default()
             }
@@ -212,7 +237,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             ..
         })
     );
-    if !field_only && !is_brownian && !table.contains_key("container") {
+    if !field_only && !is_brownian && !is_pf && !table.contains_key("container") {
         errors.push(SceneError::new(
             "container",
             "missing required table [container]",
@@ -245,6 +270,51 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             "only for pipeline = \"brownian\"",
         ));
     }
+    let mut particle_fluid = None;
+    if is_pf {
+        for (key, present) in [
+            (
+                "particle_fluid",
+                pf_section.is_some() || table.contains_key("particle_fluid"),
+            ),
+            ("liquid", liquid.is_some() || table.contains_key("liquid")),
+            ("particles", table.contains_key("particles")),
+        ] {
+            if !present {
+                errors.push(SceneError::new(
+                    key,
+                    format!("missing required table [{key}] for pipeline = \"particle_fluid\""),
+                ));
+            }
+        }
+        if let (Some(section), Some(liquid)) = (pf_section.take(), liquid.take()) {
+            let pf = ParticleFluidScene {
+                section,
+                liquid,
+                magnet: magnet.take(),
+                collisions: collisions.take().unwrap_or_default(),
+                container: fluid_container
+                    .take()
+                    .unwrap_or(FluidContainerSpec::Unbounded {}),
+            };
+            super::particle_fluid::validate(&pf, &mut particles, &mut errors);
+            particle_fluid = Some(pf);
+        }
+    } else {
+        for (key, present) in [
+            ("particle_fluid", pf_section.is_some()),
+            ("liquid", liquid.is_some()),
+            ("magnet", magnet.is_some()),
+            ("collisions", collisions.is_some()),
+        ] {
+            if present {
+                errors.push(SceneError::new(
+                    key,
+                    "only for pipeline = \"particle_fluid\"",
+                ));
+            }
+        }
+    }
     // fibres from packing recordings, appended after the explicit ones (reported under
     // fibre_packings[i] when invalid)
     for (i, spec) in &fibre_packings {
@@ -258,9 +328,32 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     let mut total: u64 = 0;
     for (i, g) in &particles {
         let p = format!("particles[{i}]");
-        check(&mut errors, g.count >= 1, &format!("{p}.count"), || {
-            format!("must be >= 1, got {}", g.count)
-        });
+        if !is_pf {
+            check(&mut errors, g.count >= 1, &format!("{p}.count"), || {
+                format!("must be >= 1, got {}", g.count)
+            });
+        }
+        if is_pf && g.moment.is_some() {
+            errors.push(SceneError::new(
+                format!("{p}.moment"),
+                "only for pipeline = \"brownian\"",
+            ));
+        }
+        if is_brownian {
+            for (key, present) in [
+                ("density", g.density.is_some()),
+                ("density_ratios", g.density_ratios.is_some()),
+                ("velocity", g.velocity.is_some()),
+                ("volume_fraction", g.volume_fraction.is_some()),
+            ] {
+                if present {
+                    errors.push(SceneError::new(
+                        format!("{p}.{key}"),
+                        "only for pipeline = \"particle_fluid\"",
+                    ));
+                }
+            }
+        }
         total = total.saturating_add(g.count);
         if is_brownian {
             match g.shape {
@@ -278,10 +371,14 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                     "the brownian pipeline simulates spheres only",
                 )),
             }
-        } else {
+        } else if !is_pf {
             for (key, present) in [
                 ("moment", g.moment.is_some()),
                 ("placement", g.placement.is_some()),
+                ("density", g.density.is_some()),
+                ("density_ratios", g.density_ratios.is_some()),
+                ("velocity", g.velocity.is_some()),
+                ("volume_fraction", g.volume_fraction.is_some()),
             ] {
                 if present {
                     errors.push(SceneError::new(
@@ -399,7 +496,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
             format!("must be >= 1, got {v}")
         });
     }
-    if errors.is_empty() && !is_brownian && !field_only {
+    if errors.is_empty() && !is_brownian && !is_pf && !field_only {
         let groups: Vec<&ParticleGroup> = particles.iter().map(|(_, g)| g).collect();
         super::packing_geometry::validate(container.as_ref(), &groups, &packing, &mut errors);
     }
@@ -411,7 +508,8 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
     validate_fibres(&fibres, external_field.as_ref(), &mut errors);
     match (simulation, container, errors.is_empty()) {
         (simulation, container, true)
-            if field_only || (simulation.is_some() && (container.is_some() || is_brownian)) =>
+            if field_only
+                || (simulation.is_some() && (container.is_some() || is_brownian || is_pf)) =>
         {
             Ok(Scene {
                 text: text.to_string(),
@@ -423,6 +521,7 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 packing,
                 record,
                 brownian,
+                particle_fluid,
                 extensions,
             })
         }

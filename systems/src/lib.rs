@@ -8,6 +8,9 @@
 //! * [`geometry`]: volumes, inertia, segment distances.
 //! * [`field`]: magnetic fields, gradients and forces of magnetised cylinders.
 //! * [`brownian`]: Brownian dynamics of magnetic nanoparticles (thesis 000, ch. 6).
+//! * [`fluid`]: inertial particles in magnetised liquids: magnetic buoyancy, Maxey-Riley with
+//!   Basset history (thesis 002, ch. 1-2).
+//! * [`collision`]: hard-particle impulse collisions with restitution and Coulomb friction.
 //! * [`packing`]: the mechanical contraction method.
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
@@ -17,7 +20,9 @@
 pub mod analysis;
 pub mod brownian;
 pub mod clock;
+pub mod collision;
 pub mod field;
+pub mod fluid;
 pub mod forces;
 pub mod geometry;
 pub mod packing;
