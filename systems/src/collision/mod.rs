@@ -1,0 +1,34 @@
+//! Hard-particle collisions: impulses with restitution and Coulomb friction, wet restitution,
+//! time of impact, and the event-driven collision step (thesis 002, ch. 2 and ch. 4).
+//!
+//! Pure kernels, no ECS:
+//! * [`impulse`]: one impulse law for any two rigid bodies (Poisson restitution, tangential
+//!   restitution, Coulomb friction; eq. 4.12–4.15, reducing to Hoomans' 2.33–2.35 for spheres).
+//! * [`restitution`]: Izard et al.'s wet normal restitution (2.36) and the [`CollisionModel`]
+//!   that gives the law of a pair or particle–wall impact at a given approach speed.
+//! * [`toi`]: analytic sphere–sphere and sphere–plane time of impact and contact frames, behind the
+//!   [`toi::CollisionShape`] extension point for spheroids.
+//! * [`domain`]: periodic axes and walls.
+//! * [`engine`]: the event-driven collision step over a whole particle set ([`CollisionEngine`]).
+//! * `cells` (private): candidate pairs from a cell grid.
+//!
+//! Deviations from the thesis (errata and filled gaps) are listed in each module header: the
+//! momentum-conserving sign of (2.33), the inverted restitution ratios (L618/L624), the clamp of
+//! (2.36) below its threshold, the wall and unequal-sphere Stokes numbers, the rest speed, the
+//! approach tolerance, the event cap and the overlap projection.
+
+mod cells;
+pub mod domain;
+pub mod engine;
+pub mod impulse;
+pub mod restitution;
+pub mod toi;
+
+pub use domain::{CollisionDomain, PeriodicAxis};
+pub use engine::{
+    CollisionEngine, CollisionError, CollisionEvent, CollisionReport, CollisionStats, EngineConfig,
+    InverseInertia, LastCollision, ParticleArrays, Partner,
+};
+pub use impulse::{CollisionImpulse, CollisionLaw, FrictionRegime, RigidBody, collision_impulse};
+pub use restitution::{CollisionModel, Counterpart, Restitution};
+pub use toi::{CollisionShape, ContactGeometry, Plane};
