@@ -298,3 +298,144 @@ impl MagnetModel {
         Some(0.5 * (a + b))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table_2_3() -> (Liquid, MagnetModel) {
+        (
+            Liquid {
+                density: 1400.0,
+                viscosity: 5.54e-3,
+                susceptibility: 7e-4,
+            },
+            MagnetModel::Two {
+                surface_field: 637e3,
+                pole_size: 0.2,
+                half_height: 0.075,
+            },
+        )
+    }
+
+    fn table_2_1() -> (Liquid, MagnetModel) {
+        (
+            Liquid {
+                density: 1403.0,
+                viscosity: 5.54e-3,
+                susceptibility: 7e-4,
+            },
+            MagnetModel::Bottom {
+                surface_field: 422e3,
+                pole_size: 0.1181,
+                half_height: 0.075,
+            },
+        )
+    }
+
+    #[test]
+    fn table_2_3_sorting_range_and_resolution() {
+        let (liquid, m) = table_2_3();
+        let range = m.sorting_range(&liquid, 9.81) / liquid.density;
+        let grad = m.max_density_gradient(&liquid, 9.81) * 0.075 / liquid.density;
+        assert!((range - 0.4046).abs() < 1e-3, "{range}");
+        assert!((grad - 0.9705).abs() < 1e-3, "{grad}");
+        // the sorting range is the departure at the faces, found independently by scanning
+        let scan = (0..=2000)
+            .map(|k| -0.075 + 0.15 * k as f64 / 2000.0)
+            .map(|y| (m.apparent_density(&liquid, 9.81, y) - liquid.density).abs())
+            .fold(0.0, f64::max);
+        assert!((scan / liquid.density - range).abs() < 1e-12);
+    }
+
+    #[test]
+    fn field_gradients_match_finite_differences_to_1e_10() {
+        for (liquid, m) in [table_2_1(), table_2_3()] {
+            let top = MagnetModel::Top {
+                surface_field: 422e3,
+                pole_size: 0.1181,
+                half_height: 0.075,
+            };
+            for model in [m, top] {
+                for k in 0..=20 {
+                    let y = -0.07 + 0.14 * k as f64 / 20.0;
+                    let (_, dh) = model.field(y);
+                    let fd = d4(|y| model.field(y).0, y);
+                    assert!((dh - fd).abs() <= 1e-10 * dh.abs().max(1.0), "{dh} {fd}");
+                    let rho = |y: f64| model.apparent_density(&liquid, 9.81, y);
+                    let g = model.apparent_density_gradient(&liquid, 9.81, y);
+                    let fd = d4(rho, y);
+                    assert!((g - fd).abs() <= 1e-8 * g.abs().max(1e-3), "{g} {fd}");
+                    // apparent density against ½ μ₀ χ d(H²)/dy, differentiated numerically
+                    let kelvin =
+                        0.5 * MU0 * liquid.susceptibility * d4(|y| model.field(y).0.powi(2), y);
+                    let direct = liquid.density - kelvin / 9.81;
+                    assert!((rho(y) - direct).abs() <= 1e-10 * liquid.density);
+                }
+            }
+        }
+    }
+
+    /// Fourth-order central difference.
+    fn d4(f: impl Fn(f64) -> f64, y: f64) -> f64 {
+        let h = 1e-4;
+        (-f(y + 2.0 * h) + 8.0 * f(y + h) - 8.0 * f(y - h) + f(y - 2.0 * h)) / (12.0 * h)
+    }
+
+    #[test]
+    fn equilibrium_heights_closed_form_equal_root_finding() {
+        let (liquid, m) = table_2_1();
+        let y = m.equilibrium_height(&liquid, 9.81, 1434.0).unwrap();
+        let r = m.equilibrium_height_by_root(&liquid, 9.81, 1434.0).unwrap();
+        assert!(
+            (y - r).abs() < 1e-12 && (y / 0.075 + 0.344).abs() < 0.01,
+            "{y} {r}"
+        );
+        let pom = m.equilibrium_height(&liquid, 9.81, 1406.0).unwrap();
+        assert!((pom / 0.075 - 0.241).abs() < 1e-3, "{pom}");
+        // lighter than the liquid: no levitation above a bottom magnet
+        assert!(m.equilibrium_height(&liquid, 9.81, 1300.0).is_none());
+        assert!(
+            m.equilibrium_height_by_root(&liquid, 9.81, 1300.0)
+                .is_none()
+        );
+        // the ten density groups of the many-particle runs (spec table)
+        let (liquid, two) = table_2_3();
+        // ratios 0.7 + 0.6 k / 9 (ten evenly spaced groups)
+        for (k, expect) in [0.876, 0.774, 0.641, 0.456, 0.178].into_iter().enumerate() {
+            let ratio = 0.7 + 0.6 * k as f64 / 9.0;
+            for sign in [1.0, -1.0] {
+                let rho = liquid.density * if sign > 0.0 { ratio } else { 2.0 - ratio };
+                let y = two.equilibrium_height(&liquid, 9.81, rho).unwrap();
+                let r = two.equilibrium_height_by_root(&liquid, 9.81, rho).unwrap();
+                assert!((y - r).abs() < 1e-12);
+                assert!((y / 0.075 - sign * expect).abs() < 2e-3, "{ratio} {y}");
+            }
+        }
+        // top magnet: light particles levitate, mirror image of the bottom magnet
+        let top = MagnetModel::Top {
+            surface_field: 422e3,
+            pole_size: 0.1181,
+            half_height: 0.075,
+        };
+        let (liquid, _) = table_2_1();
+        let y = top
+            .equilibrium_height(&liquid, 9.81, 2.0 * 1403.0 - 1434.0)
+            .unwrap();
+        let r = top
+            .equilibrium_height_by_root(&liquid, 9.81, 2.0 * 1403.0 - 1434.0)
+            .unwrap();
+        assert!((y - r).abs() < 1e-12 && (y / 0.075 - 0.344).abs() < 0.01);
+    }
+
+    #[test]
+    fn printed_table_2_2_would_be_wrong() {
+        // the printed form (2π, measured from the face) puts PVC-U at -0.17 L, not -0.35 L
+        let (liquid, m) = table_2_1();
+        let (p, h0) = (0.1181, 422e3);
+        let printed = -p / (2.0 * PI)
+            * ((1434.0 - 1403.0) * p * 9.81 / (2.0 * PI * MU0 * 7e-4 * h0 * h0)).ln();
+        let ours = m.equilibrium_height(&liquid, 9.81, 1434.0).unwrap();
+        assert!((printed / 0.075 - ours / 0.075).abs() > 0.1);
+    }
+}

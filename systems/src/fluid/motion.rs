@@ -75,7 +75,7 @@ mod tests {
     #[test]
     fn implicit_step_converges_to_the_exact_relaxation_with_first_order() {
         // m dv/dt = F - k v: v(t) = F/k (1 - e^{-kt/m})
-        let (m, k, f, t_end) = (2.0, 3.0, 1.5, 1.0);
+        let (m, k, f, t_end): (f64, f64, f64, f64) = (2.0, 3.0, 1.5, 1.0);
         let exact = f / k * (1.0 - (-k * t_end / m).exp());
         let mut errs = Vec::new();
         for n in [100, 200, 400] {
