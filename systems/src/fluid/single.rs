@@ -197,3 +197,7 @@ impl SphereInLiquid {
         Ok(out)
     }
 }
+
+#[cfg(test)]
+#[path = "single_tests.rs"]
+mod tests;
