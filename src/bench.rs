@@ -185,9 +185,12 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
     if what == "brownian" {
         return crate::bench_brownian::bench_brownian(as_json, quick);
     }
+    if what == "particle-fluid" {
+        return crate::fluid_charts::bench_particle_fluid(as_json, quick);
+    }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown benchmark `{what}`; available: packing, field, brownian"
+            "unknown benchmark `{what}`; available: packing, field, brownian, particle-fluid"
         )));
     }
     let threads = rayon::current_num_threads();
@@ -288,6 +291,10 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
         "cylinder" => return crate::packing_charts::chart_cylinder(out, quick),
         "wedge" => return crate::packing_charts::chart_wedge(out, quick),
         "superballs" => return crate::packing_charts::chart_superballs(out, quick),
+        "levitation" => return crate::fluid_charts::chart_levitation(out, quick),
+        "history" => return crate::fluid_charts::chart_history(out, quick),
+        "collisions" => return crate::fluid_charts::chart_collisions(out, quick),
+        "separation" => return crate::fluid_charts::chart_separation(out, quick),
         "sq-contact" => {
             std::fs::create_dir_all(out)
                 .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
@@ -309,7 +316,7 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
     }
     if what != "packing" {
         return Err(BenchError::Input(format!(
-            "unknown chart `{what}`; available: packing, cylinder, wedge, superballs, sq-contact, field, brownian, brownian-cost"
+            "unknown chart `{what}`; available: packing, cylinder, wedge, superballs, sq-contact, field, brownian, brownian-cost, levitation, history, collisions, separation"
         )));
     }
     std::fs::create_dir_all(out)

@@ -19,6 +19,7 @@ pub mod bench_field;
 pub mod brownian;
 pub mod chart;
 pub mod fieldtool;
+pub mod fluid_charts;
 pub mod packing_charts;
 pub mod particle_fluid;
 pub mod replay;
