@@ -113,6 +113,25 @@ impl Simulation {
         });
         group.build(&mut app);
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
+        if let Some(cfg) = app
+            .world
+            .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
+            .cloned()
+        {
+            let mut rows: Vec<(ParticleId, f64)> = app
+                .world
+                .query::<(&ParticleId, &InertialBody)>()
+                .iter(&app.world)
+                .map(|(id, b)| (*id, b.density))
+                .collect();
+            rows.sort_by_key(|r| r.0);
+            app.world
+                .insert_resource(magsep_plugins::recorder::ParticleColours(
+                    rows.iter()
+                        .map(|r| crate::particle_fluid::view::density_colour(&cfg, r.1))
+                        .collect(),
+                ));
+        }
         if let Some(path) = &options.record {
             let meta = RecordingMetadata {
                 scene_text: scene.text.clone(),
@@ -143,6 +162,13 @@ impl Simulation {
                     .collect(),
             );
             writer.set_walls(app.world.resource::<Container>().walls());
+            if let Some(cfg) = app
+                .world
+                .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
+            {
+                let edges = app.world.resource::<Container>().edges();
+                writer.set_backdrop(crate::particle_fluid::view::magnet_backdrop(cfg, edges));
+            }
             let mut shapes: Vec<_> = app
                 .world
                 .query::<(&ParticleId, &Shape)>()

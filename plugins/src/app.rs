@@ -89,8 +89,11 @@ impl Default for SimApp {
 }
 
 impl SimApp {
-    /// An empty app with the configured sets.
+    /// An empty app with the configured sets. Also makes sure bevy's compute task pool exists,
+    /// which systems iterating queries in parallel need under any executor (its threads only
+    /// split per-entity work, so results do not depend on their number).
     pub fn new() -> Self {
+        bevy_tasks::ComputeTaskPool::get_or_init(bevy_tasks::TaskPool::default);
         let mut observe = Schedule::new(ObserveSchedule);
         observe.set_build_settings(strict_build_settings());
         Self {

@@ -57,6 +57,11 @@ pub struct BrownianFrameStatus {
     pub stats: BrownianStats,
 }
 
+/// Per-particle viewer colours in `ParticleId` order (a resource; e.g. the particle-fluid
+/// pipeline colours by density). Brownian runs colour by capture instead.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct ParticleColours(pub Vec<[f32; 4]>);
+
 /// Colour of a free particle in the viewer (RGBA).
 pub const FREE_COLOUR: [f32; 4] = [0.35, 0.55, 0.85, 1.0];
 /// Colour of a captured particle in the viewer (RGBA).
@@ -131,6 +136,13 @@ pub fn gather_frame(
     }
 }
 
+/// What the recorder reads of the brownian and particle-fluid pipelines, if present.
+type PipelineViews<'w> = (
+    Option<Res<'w, BrownianConfig>>,
+    Option<Res<'w, BrownianStats>>,
+    Option<Res<'w, ParticleColours>>,
+);
+
 /// Record: write a frame every `every` steps and when the run has stopped.
 pub fn record_frame(
     mut rec: ResMut<Recorder>,
@@ -138,7 +150,7 @@ pub fn record_frame(
     container: Res<Container>,
     status: Option<Res<PackingStatus>>,
     ws: Option<Res<McmWorkspace>>,
-    (brownian, stats): (Option<Res<BrownianConfig>>, Option<Res<BrownianStats>>),
+    (brownian, stats, fixed_colours): PipelineViews,
     q: FrameQuery,
 ) {
     if rec.writer.is_none() || rec.last_step == Some(clock.step) {
@@ -163,18 +175,24 @@ pub fn record_frame(
         stats.as_ref(),
         &q,
     );
-    let colours: Option<Vec<[f32; 4]>> = brownian.as_ref().map(|_| {
-        let mut rows: Vec<_> = q.iter().map(|r| (*r.0, r.5.and_then(|c| c.0))).collect();
-        rows.sort_by_key(|r| r.0);
-        rows.iter()
-            .map(|r| {
-                if r.1.is_some() {
-                    CAPTURED_COLOUR
-                } else {
-                    FREE_COLOUR
-                }
-            })
-            .collect()
+    let fixed = fixed_colours
+        .as_ref()
+        .filter(|c| c.0.len() == frame.ids.len())
+        .map(|c| c.0.clone());
+    let colours: Option<Vec<[f32; 4]>> = fixed.or_else(|| {
+        brownian.as_ref().map(|_| {
+            let mut rows: Vec<_> = q.iter().map(|r| (*r.0, r.5.and_then(|c| c.0))).collect();
+            rows.sort_by_key(|r| r.0);
+            rows.iter()
+                .map(|r| {
+                    if r.1.is_some() {
+                        CAPTURED_COLOUR
+                    } else {
+                        FREE_COLOUR
+                    }
+                })
+                .collect()
+        })
     });
     let result = rec
         .writer

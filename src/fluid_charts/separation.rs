@@ -1,13 +1,181 @@
-//! Placeholder (being written).
+//! `magsep chart separation --out DIR [--quick]`: the many-particle density separation runs of
+//! thesis 002, §2.5.3 (figs. 2.16, 2.18), from the shipped scenes `scenes/mds_case*.toml`
+//! (compiled in), all one-way coupled (magsep has no fluid solver yet, so the thesis's case
+//! 1A runs as its case 1C).
+//!
+//! Full mode runs the scenes as shipped (table 2.4 particle counts, 5 s); `--quick` shrinks the
+//! channel's periods by 3 (the particle count by 9 at the same volume fraction; case 2 by 6)
+//! and the duration to 2.5 s. Charts:
+//! * `separation_cases.svg`: e_m(t) of cases 1A(=1C), 1B (no history), 1D (no collisions) and
+//!   4 (impurity 0.5) (fig. 2.16a), and 1A, 2 (2 mm), 3 (Φ = 0.04), 4 (fig. 2.18);
+//! * `separation_groups.svg`: e_m(t) per density group of case 1A (fig. 2.16b).
+
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde_json::{Value, json};
 
 use crate::bench::BenchError;
+use crate::chart::{Chart, Figure, LegendPosition, Line, Series, Style, write_svg};
+use crate::scene::parse_scene;
+use crate::sim::{RunOptions, Simulation};
+use magsep_systems::fluid::observe::SeparationCurve;
 
-/// Not yet written.
+/// The shipped cases: (name, scene, thesis time to e_m = 0.02 [s] where stated).
+const CASES: [(&str, &str, Option<f64>); 6] = [
+    (
+        "1A (=1C)",
+        include_str!("../../scenes/mds_case1a.toml"),
+        Some(3.0),
+    ),
+    (
+        "1B",
+        include_str!("../../scenes/mds_case1b.toml"),
+        Some(1.5),
+    ),
+    (
+        "1D",
+        include_str!("../../scenes/mds_case1d.toml"),
+        Some(2.5),
+    ),
+    ("2", include_str!("../../scenes/mds_case2.toml"), None),
+    ("3", include_str!("../../scenes/mds_case3.toml"), None),
+    ("4", include_str!("../../scenes/mds_case4.toml"), Some(4.0)),
+];
+
+/// The period of the shipped channel [m] (4π L / 3).
+const SIDE: &str = "0.3141592653589793";
+
+fn runtime(e: impl std::fmt::Display) -> BenchError {
+    BenchError::Runtime(e.to_string())
+}
+
+/// The scene text of a case, reduced in quick mode.
+fn reduced(text: &str, quick: bool, small: bool) -> String {
+    if !quick {
+        return text.to_string();
+    }
+    let factor = if small { 6.0 } else { 3.0 };
+    let side = std::f64::consts::PI * 0.1 / factor;
+    text.replace(&format!("[{SIDE}, {SIDE}]"), &format!("[{side}, {side}]"))
+        .replace("duration = 5.0 ", "duration = 2.5 ")
+}
+
+fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
+    let scene = parse_scene(text, &Default::default()).map_err(runtime)?;
+    let mut sim = Simulation::from_scene(
+        &scene,
+        RunOptions {
+            single_threaded: true,
+            ..Default::default()
+        },
+    )
+    .map_err(runtime)?;
+    let summary = sim.run(|_| {}).map_err(runtime)?;
+    let curve = sim
+        .app
+        .world
+        .get_resource::<SeparationCurve>()
+        .cloned()
+        .unwrap_or_default();
+    Ok((curve, summary))
+}
+
+fn points(c: &SeparationCurve, values: &[f64]) -> Vec<(f64, f64)> {
+    c.times
+        .iter()
+        .copied()
+        .zip(values.iter().copied())
+        .collect()
+}
+
+/// Write the charts and print a JSON summary.
 ///
 /// # Errors
-/// Always [`BenchError::Input`] until written.
-pub fn chart_separation(out: &std::path::Path, quick: bool) -> Result<(), BenchError> {
-    let _ = quick;
-    let _ = out;
-    Err(BenchError::Input("not yet available".into()))
+/// [`BenchError::Runtime`] if a run or writing fails.
+pub fn chart_separation(out: &Path, quick: bool) -> Result<(), BenchError> {
+    std::fs::create_dir_all(out)
+        .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
+    let results: Vec<(SeparationCurve, Value)> = CASES
+        .par_iter()
+        .map(|(name, text, _)| run_case(&reduced(text, quick, *name == "2")))
+        .collect::<Result<_, _>>()?;
+    let note = if quick {
+        " (quick: periods / 3, case 2 / 6, 2.5 s)"
+    } else {
+        " (table 2.4 counts)"
+    };
+    let level = Line::new(
+        "e_m = 0.02",
+        vec![(0.0, 0.02), (if quick { 2.5 } else { 5.0 }, 0.02)],
+    )
+    .dashed(true);
+    let panel = |title: &str, which: &[&str]| {
+        let mut c = Chart::new(title)
+            .x_label("t [s]")
+            .y_label("e_m")
+            .y_log(true)
+            .legend(LegendPosition::TopRight)
+            .line(level.clone());
+        for (k, (name, _, _)) in CASES.iter().enumerate() {
+            if which.contains(name) {
+                let curve = &results[k].0;
+                c = c.series(
+                    Series::new(format!("case {name}"), points(curve, &curve.total))
+                        .style(Style::Line),
+                );
+            }
+        }
+        c
+    };
+    let fig = Figure::new(format!("Separation error, one-way coupled{note}"), 2)
+        .panel(panel(
+            "history and collisions (fig. 2.16a)",
+            &["1A (=1C)", "1B", "1D", "4"],
+        ))
+        .panel(panel(
+            "size, volume fraction, impurity (fig. 2.18)",
+            &["1A (=1C)", "2", "3", "4"],
+        ));
+    let path = out.join("separation_cases.svg");
+    write_svg(&path, &fig.to_svg(560.0, 400.0)).map_err(runtime)?;
+    let base = &results[0].0;
+    let mut groups = Chart::new(format!(
+        "Case 1A (=1C): e_m per density group (fig. 2.16b){note}"
+    ))
+    .x_label("t [s]")
+    .y_label("e_m of the group")
+    .y_log(true)
+    .legend(LegendPosition::TopRight);
+    let rho_f = 1400.0;
+    for (rho, e) in base.group_densities.iter().zip(&base.groups) {
+        if *rho < rho_f {
+            continue; // the light groups mirror the heavy ones
+        }
+        groups = groups.series(
+            Series::new(
+                format!("|1 - rho_p/rho_f| = {:.3}", (rho / rho_f - 1.0).abs()),
+                points(base, e),
+            )
+            .style(Style::Line),
+        );
+    }
+    let path_g = out.join("separation_groups.svg");
+    write_svg(&path_g, &groups.to_svg(640.0, 420.0)).map_err(runtime)?;
+    let cases: Vec<Value> = CASES
+        .iter()
+        .zip(&results)
+        .map(|((name, _, thesis), (curve, s))| {
+            json!({
+                "case": name, "particles": s["particles"], "time_to_0.02": curve.time_to(0.02),
+                "thesis_time_to_0.02": thesis, "final_error": curve.total.last(),
+                "collisions": s["collisions"], "wall_time_s": s["wall_time_s"],
+            })
+        })
+        .collect();
+    println!(
+        "{}",
+        json!({"charts": [path.display().to_string(), path_g.display().to_string()], "quick": quick, "cases": cases})
+    );
+    Ok(())
 }

@@ -2,6 +2,7 @@
 //! its stability diagnostics.
 
 pub mod replay;
+pub mod view;
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
@@ -30,7 +31,7 @@ fn thin(v: &[f64], max: usize) -> Vec<f64> {
     }
     let k = v.len().div_ceil(max);
     let mut out: Vec<f64> = v.iter().step_by(k).copied().collect();
-    if (v.len() - 1) % k != 0 {
+    if !(v.len() - 1).is_multiple_of(k) {
         out.push(*v.last().unwrap_or(&f64::NAN));
     }
     out

@@ -231,7 +231,10 @@ pub fn spawn_particle_fluid(
     world.insert_resource(container);
     world.insert_resource(FluidDomain(domain));
     if cfg.terms.collisions {
-        world.insert_resource(CollisionWorkspace::new(pf.collisions.model(&pf.liquid)));
+        world.insert_resource(CollisionWorkspace::new(
+            pf.collisions.model(&pf.liquid),
+            pf.collisions.history.unwrap_or_default(),
+        ));
     }
     world.insert_resource(StepClock::new(cfg.dt));
     world.insert_resource(cfg);

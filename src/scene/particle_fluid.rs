@@ -37,6 +37,7 @@
 
 use glam::DVec3;
 use magsep_systems::collision::{CollisionModel, Restitution};
+use magsep_systems::fluid::collide::CollisionHistory;
 use magsep_systems::fluid::config::{
     ForceTerms, HistoryChoice, Integrator, ParticleFluidConfig, STANDARD_GRAVITY,
 };
@@ -159,8 +160,10 @@ pub struct CollisionsSection {
     pub friction: Option<f64>,
     /// Tangential restitution e_t. Default 0.
     pub tangential_restitution: Option<f64>,
-    /// Approaches slower than this are fully inelastic [m/s]. Default 1e-3.
+    /// Approaches slower than this are fully inelastic [m/s]. Default 0.01.
     pub rest_speed: Option<f64>,
+    /// What a collision does to the Basset history: `reset` (thesis, default) or `keep`.
+    pub history: Option<CollisionHistory>,
 }
 
 impl CollisionsSection {

@@ -44,6 +44,18 @@ pub struct FibreShape {
     pub half_length: f64,
 }
 
+/// A translucent box drawn behind the particles in every scene update (entity `backdrop`),
+/// e.g. the slices of a magnet field's colour map.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BackdropCube {
+    /// Centre \[m\].
+    pub center: DVec3,
+    /// Edge lengths \[m\].
+    pub size: DVec3,
+    /// Colour (RGBA, 0..1).
+    pub colour: [f32; 4],
+}
+
 /// Metadata written once at the start of a recording (MCAP metadata record `magsep`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct RecordingMetadata {

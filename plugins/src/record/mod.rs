@@ -77,7 +77,7 @@ mod tests;
 
 use std::path::PathBuf;
 
-pub use frame::{FibreShape, ParticleFrame, RecordingMetadata};
+pub use frame::{BackdropCube, FibreShape, ParticleFrame, RecordingMetadata};
 pub use reader::{ChannelInfo, Recording, read_recording, read_recording_bytes};
 pub use writer::{RecordingWriter, log_time_ns};
 

@@ -1,6 +1,6 @@
 //! The `/scene` channel: one `foxglove.SceneUpdate` per frame.
 
-use super::{FibreShape, ParticleFrame, SCENE_FRAME_ID};
+use super::{BackdropCube, FibreShape, ParticleFrame, SCENE_FRAME_ID};
 use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, Duration, LinePrimitive, Point3, Pose, Quaternion,
     SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, TriangleListPrimitive, Vector3,
@@ -90,7 +90,12 @@ pub(crate) struct SceneDecor {
     pub walls: Option<Walls>,
     /// Per-particle superquadric semi-axes (zero: sphere or rod); empty: none.
     pub semi_axes: Vec<DVec3>,
+    /// Boxes drawn behind the particles (entity `backdrop`); empty: none.
+    pub backdrop: Vec<BackdropCube>,
 }
+
+/// Id of the backdrop entity (e.g. a magnet field's colour map).
+pub const BACKDROP_ENTITY: &str = "backdrop";
 
 /// Id of the walls entity.
 pub const WALLS_ENTITY: &str = "walls";
@@ -258,6 +263,20 @@ pub(crate) fn scene_update(
     }
     if let Some(w) = decor.walls {
         entities.push(wall_entity(w, frame.box_edges, entity(WALLS_ENTITY)));
+    }
+    if !decor.backdrop.is_empty() {
+        entities.push(SceneEntity {
+            cubes: decor
+                .backdrop
+                .iter()
+                .map(|b| CubePrimitive {
+                    pose: pose(b.center, DQuat::IDENTITY),
+                    size: Some(vec3(b.size)),
+                    color: colour(b.colour),
+                })
+                .collect(),
+            ..entity(BACKDROP_ENTITY)
+        });
     }
     if !fibres.is_empty() {
         entities.push(SceneEntity {

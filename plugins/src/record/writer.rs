@@ -1,6 +1,6 @@
 //! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame.
 
-use super::frame::FibreShape;
+use super::frame::{BackdropCube, FibreShape};
 use super::proto::{ParticleState, particle_count, state_schema};
 use super::scene::{SceneDecor, scene_update};
 use super::{
@@ -201,6 +201,11 @@ impl RecordingWriter {
     /// following scene update.
     pub fn set_walls(&mut self, walls: Option<Walls>) {
         self.decor.walls = walls;
+    }
+
+    /// Boxes to draw behind the particles (entity `backdrop`) in every following scene update.
+    pub fn set_backdrop(&mut self, cubes: Vec<BackdropCube>) {
+        self.decor.backdrop = cubes;
     }
 
     /// Superquadric semi-axes per particle (frame order; zero for spheres and rods): such

@@ -105,7 +105,11 @@ impl Candidates {
     /// header).
     pub fn build(&mut self, x: &[DVec3], radii: &[f64], domain: &CollisionDomain, reach: f64) {
         let n = x.len();
-        let r_max = radii.iter().copied().filter(|r| r.is_finite()).fold(0.0, f64::max);
+        let r_max = radii
+            .iter()
+            .copied()
+            .filter(|r| r.is_finite())
+            .fold(0.0, f64::max);
         let mut edge = (2.0 * r_max + reach).max(f64::MIN_POSITIVE);
         if !edge.is_finite() {
             edge = f64::MAX;
@@ -117,7 +121,8 @@ impl Candidates {
         }
         let limit = (4 * n + 27) as f64;
         let axes = loop {
-            let axes: [Axis; 3] = std::array::from_fn(|k| Axis::layout(domain, k, lo[k], hi[k], edge));
+            let axes: [Axis; 3] =
+                std::array::from_fn(|k| Axis::layout(domain, k, lo[k], hi[k], edge));
             let total: f64 = axes.iter().map(|a| a.cells as f64).product();
             if total <= limit || edge >= f64::MAX / 2.0 {
                 break axes;
@@ -156,13 +161,15 @@ impl Candidates {
         for i in 0..n {
             let c = self.cell_of[i];
             let home = [c % nx, (c / nx) % ny, c / (nx * ny)];
-            let [(bx, lx), (by, ly), (bz, lz)] = std::array::from_fn(|k| axes[k].neighbours(home[k]));
+            let [(bx, lx), (by, ly), (bz, lz)] =
+                std::array::from_fn(|k| axes[k].neighbours(home[k]));
             let start = self.partners.len();
             for &cz in &bz[..lz] {
                 for &cy in &by[..ly] {
                     for &cx in &bx[..lx] {
                         let cell = cell_id([cx, cy, cz]);
-                        for &j in &self.cell_items[self.cell_start[cell]..self.cell_start[cell + 1]] {
+                        for &j in &self.cell_items[self.cell_start[cell]..self.cell_start[cell + 1]]
+                        {
                             let j = j as usize;
                             if j == i {
                                 continue;
@@ -227,7 +234,12 @@ mod tests {
         let mut c = Candidates::default();
         let domain = CollisionDomain::unbounded();
         c.build(&[], &[], &domain, 0.0);
-        let x = [DVec3::ZERO, DVec3::NAN, DVec3::new(1e300, 0.0, 0.0), DVec3::X];
+        let x = [
+            DVec3::ZERO,
+            DVec3::NAN,
+            DVec3::new(1e300, 0.0, 0.0),
+            DVec3::X,
+        ];
         c.build(&x, &[0.5, 0.5, 0.5, 0.5], &domain, f64::INFINITY);
         assert_eq!(c.of(0), &[2, 3]);
         c.build(&x, &[0.0; 4], &domain, 0.0);

@@ -4,45 +4,62 @@
 //! **Input.** Dense arrays in a stable particle order: start positions `x_n`, velocities `v` and
 //! angular velocities `Ω` *already updated by the force integrator for this step*, radii, inverse
 //! masses, inverse inertias, densities; a [`CollisionDomain`]; the step `h`; a [`CollisionModel`].
+//! **Output:** end-of-step positions (unwrapped), post-collision velocities and angular
+//! velocities, and a [`CollisionReport`] (events, each particle's last collision for the Basset
+//! reset, counters).
 //!
 //! **Model.** Within the step the motion is ballistic, "the linear and angular velocities of the
 //! particles are assumed to change only due to collisions" (L1525), and sustained contacts are
-//! sequences of instantaneous binary collisions (L1527–1534). Every collision uses the impulse law of
-//! [`super::impulse`] with the coefficients from [`CollisionModel::law`] at the approach speed.
+//! sequences of instantaneous binary collisions (L1527–1534). Every collision uses the impulse law
+//! of [`super::impulse`] with the coefficients from [`CollisionModel::law`] at the approach speed.
 //!
 //! **Algorithm.**
-//! 1. Candidate pairs from a cell grid ([`super::cells`]) with reach `2 V h + 0.1 r_max`, `V` a
-//!    bound on every speed during the step (the initial maximum; if a collision produces a faster
-//!    particle, `V` is raised to 1.5× that speed and the grid and all predictions are rebuilt).
-//! 2. Each particle keeps a local time and is advanced lazily. Each particle's earliest predicted
+//! 1. Candidate pairs from a cell grid (private `cells` module) with reach `2 V h + 0.1 r_max`,
+//!    `V` a bound on every speed during the step (the maximum after step 2; if a collision
+//!    produces a faster particle, `V` is raised to 1.5× that speed and the grid and all
+//!    predictions are rebuilt).
+//! 2. Resting contacts (touching, or closer than `rest_speed · h`, and approaching slower than
+//!    `rest_speed`) are resolved at `t = 0` by a warm-started projected Gauss–Seidel solve of
+//!    fully inelastic contacts with Coulomb friction (private `resting` submodule). It is the
+//!    converged limit of the infinite sequence of `e = 0` binary collisions (inelastic collapse)
+//!    that a bed under gravity would otherwise exchange at `t = 0` every step, which the event
+//!    loop would resolve only with `O(height²)` events per particle. Its impulses are reported as
+//!    events at time 0 flagged `resting`.
+//! 3. Each particle keeps a local time and is advanced lazily. Each particle's earliest predicted
 //!    event (pair TOI from [`super::toi`] or wall TOI) sits in a binary heap ordered by
 //!    `(time, lower index, higher index or N + wall, owner)`; per-particle version counters
 //!    discard stale events (a stale event whose owner is unchanged re-predicts the owner).
-//! 3. The earliest event advances its particles to the event time, applies the impulse and
+//! 4. The earliest event advances its particles to the event time, applies the impulse and
 //!    re-predicts both within the remaining step; until the heap is empty. All particles are then
 //!    advanced to `h` with their final velocities.
-//! 4. Position projection (a safety net, *not physics*): a few Gauss–Seidel sweeps over the
-//!    candidate pairs (then the walls) push overlapping pairs apart along the centre line, split by
-//!    inverse mass (walls and zero-inverse-mass particles immovable). Velocities are untouched. The
-//!    largest overlap before and after is reported.
+//! 5. Position projection (a safety net, *not physics*): Gauss–Seidel sweeps over the candidate
+//!    pairs, then the walls, push overlapping pairs apart along the centre line, split by inverse
+//!    mass (walls and zero-inverse-mass particles immovable), until no overlap exceeds
+//!    `projection_tolerance` (or `projection_sweeps`). Velocities are untouched. The largest
+//!    overlap before and after is reported.
 //!
 //! **Choices where the thesis is silent.**
 //! * Approaches slower than `approach_tolerance · (r_i + r_j)/h` (walls: `· 2 r_i/h`) are ignored:
 //!   they cannot open an overlap larger than `approach_tolerance` times the diameter within the
-//!   step, and the projection removes it. This ends the geometric cascades of e = 0 collisions in
-//!   touching clusters (inelastic collapse) once they no longer matter.
-//! * Event cap: a particle that took part in `max_events_per_particle` events gets no further
-//!   events this step (it moves ballistically to `h`; its overlaps are projected); reported as
-//!   `capped_particles`/`skipped_events`. The loop therefore always terminates.
-//! * Resting contacts: the rest-speed rule of [`CollisionModel`] makes slow impacts fully
-//!   inelastic, so a particle resting on a wall (or a bed) under gravity loses its approach velocity
-//!   each step instead of bouncing or sinking.
+//!   step, and the projection removes it. At the resting contacts of step 2, approaches up to
+//!   twice the solve's remaining residual are ignored too (the event loop would only continue the
+//!   same Gauss–Seidel iteration, one binary collision at a time).
+//! * Dense clusters: after `defer_slow_after` events of a particle in one step, its approaches
+//!   slower than `rest_speed` are deferred (overlap `< rest_speed · h`, removed by the projection,
+//!   the next step's resting solve settles the velocities). Hard cap: a particle that took part
+//!   in `max_events_per_particle` events gets no further events this step (reported as
+//!   `capped_particles`/`skipped_events`). The loop therefore always terminates.
+//! * The rest-speed rule of [`CollisionModel`] makes slow impacts fully inelastic, so a particle
+//!   resting on a wall (or a bed) under gravity loses its approach velocity each step instead of
+//!   bouncing or sinking.
 //! * Positions are returned **unwrapped** (periodic wrapping is the caller's; see
-//!   [`CollisionDomain::wrap`]). Overlaps are reported relative to `r_i + r_j` (the mean diameter;
-//!   `2 r_i` for walls).
+//!   [`CollisionDomain::wrap`]). Overlaps are reported relative to `r_i + r_j` (the mean
+//!   diameter; `2 r_i` for walls).
 //! * The inverse inertia is held fixed during the step (exact for spheres with isotropic inertia).
-//! * Deterministic: single-threaded, fixed orders everywhere; the same input gives bitwise the same
-//!   output.
+//! * The warm start keys contacts by particle index: call
+//!   [`CollisionEngine::clear_warm_start`] when the particle order or set changes.
+//! * Deterministic: single-threaded, fixed orders everywhere; the same input gives bitwise the
+//!   same output.
 //!
 //! Spheres only (radii); spheroids need their shape and orientation arrays and a bisection TOI
 //! ([`super::toi`] header).
@@ -56,169 +73,18 @@ use super::cells::Candidates;
 use super::domain::CollisionDomain;
 use super::impulse::{CollisionLaw, FrictionRegime, RigidBody, collision_impulse};
 use super::restitution::{CollisionModel, Counterpart};
-use super::toi::{sphere_plane_contact, sphere_plane_toi, sphere_sphere_contact, sphere_sphere_toi};
+use super::toi::{
+    sphere_plane_contact, sphere_plane_toi, sphere_sphere_contact, sphere_sphere_toi,
+};
 
-/// Settings of the event loop.
-///
-/// ```
-/// use magsep_systems::collision::engine::EngineConfig;
-/// let c = EngineConfig::default();
-/// assert_eq!((c.max_events_per_particle, c.projection_sweeps), (64, 4));
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EngineConfig {
-    /// Events a particle may take part in per step. Default: 64. Range: ≥ 1.
-    pub max_events_per_particle: u32,
-    /// Gauss–Seidel overlap-projection sweeps after the event loop. Default: 4. Range: ≥ 0.
-    pub projection_sweeps: u32,
-    /// Approaches below `approach_tolerance · (r_i + r_j)/h` are ignored [-]. Default: 1e-6.
-    /// Range: ≥ 0.
-    pub approach_tolerance: f64,
-    /// Whether [`CollisionReport::events`] is filled. Default: true.
-    pub record_events: bool,
-}
+mod projection;
+mod resting;
+mod types;
 
-impl Default for EngineConfig {
-    fn default() -> Self {
-        Self {
-            max_events_per_particle: 64,
-            projection_sweeps: 4,
-            approach_tolerance: 1e-6,
-            record_events: true,
-        }
-    }
-}
-
-/// Inverse inertia per particle, world frame.
-#[derive(Debug, Clone, Copy)]
-pub enum InverseInertia<'a> {
-    /// Isotropic `I⁻¹ = s 𝕀` (spheres) [1/(kg m²)].
-    Scalar(&'a [f64]),
-    /// Full tensors [1/(kg m²)].
-    Tensor(&'a [DMat3]),
-}
-
-/// The particle arrays of one step, all of length `N`, in a stable particle order.
-#[derive(Debug)]
-pub struct ParticleArrays<'a> {
-    /// In: positions at the start of the step; out: at the end (unwrapped) [m].
-    pub positions: &'a mut [DVec3],
-    /// In: velocities after the force update; out: after the collisions [m/s].
-    pub velocities: &'a mut [DVec3],
-    /// In/out like `velocities` [rad/s].
-    pub angular_velocities: &'a mut [DVec3],
-    /// Radii [m].
-    pub radii: &'a [f64],
-    /// Inverse masses [1/kg] (0: immovable particle).
-    pub inv_masses: &'a [f64],
-    /// Inverse inertias.
-    pub inv_inertias: InverseInertia<'a>,
-    /// Densities (for the wet restitution) [kg/m³].
-    pub densities: &'a [f64],
-}
-
-/// The other body of a collision.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Partner {
-    /// Particle index.
-    Particle(usize),
-    /// Index into [`CollisionDomain::planes`].
-    Wall(usize),
-}
-
-/// One processed collision.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CollisionEvent {
-    /// Particle index (the lower index of a pair).
-    pub particle: usize,
-    /// The other body.
-    pub partner: Partner,
-    /// Time within the step [s].
-    pub time: f64,
-    /// Normal approach speed [m/s].
-    pub approach_speed: f64,
-    /// Stick or slide.
-    pub regime: FrictionRegime,
-    /// Whether the rest-speed rule made it fully inelastic.
-    pub resting: bool,
-    /// Impulse on `particle` (the partner receives the opposite) [N s].
-    pub impulse: DVec3,
-}
-
-/// A particle's last collision in the step (to reset its Basset history).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LastCollision {
-    /// Time within the step [s].
-    pub time: f64,
-    /// Velocity just before [m/s].
-    pub velocity_before: DVec3,
-    /// Velocity just after [m/s].
-    pub velocity_after: DVec3,
-}
-
-/// Counters of one step.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct CollisionStats {
-    /// Collisions with an impulse.
-    pub events: usize,
-    /// Of which with a wall.
-    pub wall_events: usize,
-    /// Of which sticking.
-    pub stick: usize,
-    /// Of which sliding.
-    pub slide: usize,
-    /// Of which resting contacts (fully inelastic by the rest speed).
-    pub resting: usize,
-    /// Particles that reached the event cap.
-    pub capped_particles: usize,
-    /// Predicted events dropped because a participant was capped.
-    pub skipped_events: usize,
-    /// Grid rebuilds after a speed-bound increase.
-    pub rebuilds: usize,
-    /// Largest overlap at the end of the event loop, relative to the (mean) diameter [-].
-    pub max_overlap_before_projection: f64,
-    /// Largest overlap after the projection, relative to the (mean) diameter [-].
-    pub max_overlap_after_projection: f64,
-}
-
-/// Output of [`CollisionEngine::step`] besides the updated arrays.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct CollisionReport {
-    /// Processed collisions in processing order (empty unless `record_events`).
-    pub events: Vec<CollisionEvent>,
-    /// Per particle, the last collision of the step.
-    pub last_collision: Vec<Option<LastCollision>>,
-    /// Counters.
-    pub stats: CollisionStats,
-}
-
-/// Invalid input to [`CollisionEngine::step`].
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum CollisionError {
-    /// An array's length differs from the number of positions.
-    #[error("array `{name}` has length {found}, expected {expected}")]
-    LengthMismatch {
-        /// Array name.
-        name: &'static str,
-        /// Number of positions.
-        expected: usize,
-        /// Its length.
-        found: usize,
-    },
-    /// The step is negative or not finite.
-    #[error("invalid step h = {0} s")]
-    InvalidStep(f64),
-    /// A periodic axis has a non-positive or non-finite length.
-    #[error("periodic axis {axis} has invalid length {length}")]
-    InvalidDomain {
-        /// Axis index.
-        axis: usize,
-        /// Its length.
-        length: f64,
-    },
-}
+pub use types::{
+    CollisionError, CollisionEvent, CollisionReport, CollisionStats, EngineConfig, InverseInertia,
+    LastCollision, ParticleArrays, Partner,
+};
 
 /// A predicted event. `hi ≥ N` encodes wall `hi − N`.
 #[derive(Debug, Clone, Copy)]
@@ -294,6 +160,11 @@ pub struct CollisionEngine {
     local_time: Vec<f64>,
     version: Vec<u32>,
     count: Vec<u32>,
+    v_start: Vec<DVec3>,
+    contacts: Vec<resting::Contact>,
+    warm: Vec<resting::Cached>,
+    rest_rows: Vec<usize>,
+    rest_partners: Vec<u32>,
 }
 
 impl CollisionEngine {
@@ -308,6 +179,25 @@ impl CollisionEngine {
     /// The settings.
     pub fn config(&self) -> &EngineConfig {
         &self.config
+    }
+
+    /// Replaces the settings (the warm start is kept).
+    pub fn set_config(&mut self, config: EngineConfig) {
+        self.config = config;
+    }
+
+    /// Partner codes (particle index, or `N + wall`) of particle `i`'s resting contacts this step.
+    fn resting_partners(&self, i: usize) -> &[u32] {
+        match (self.rest_rows.get(i), self.rest_rows.get(i + 1)) {
+            (Some(&a), Some(&b)) => &self.rest_partners[a..b],
+            _ => &[],
+        }
+    }
+
+    /// Forgets the resting-contact impulses kept for the warm start (call it when the particle
+    /// order or set changes between steps).
+    pub fn clear_warm_start(&mut self) {
+        self.warm.clear();
     }
 
     /// Resolves all collisions of one step of length `h` [s] and advances the positions to its end
@@ -343,7 +233,7 @@ impl CollisionEngine {
         if !(h >= 0.0 && h.is_finite()) {
             return Err(CollisionError::InvalidStep(h));
         }
-        if n > u32::MAX as usize / 2 - domain.planes.len() {
+        if n > (u32::MAX as usize / 2).saturating_sub(domain.planes.len()) {
             return Err(CollisionError::LengthMismatch {
                 name: "positions",
                 expected: u32::MAX as usize / 2,
@@ -365,6 +255,7 @@ impl CollisionEngine {
                 ..CollisionReport::default()
             },
             speed_bound: 0.0,
+            resting_residual: 0.0,
         };
         sim.run();
         Ok(sim.report)
@@ -381,6 +272,8 @@ struct Sim<'s, 'a> {
     eng: &'s mut CollisionEngine,
     report: CollisionReport,
     speed_bound: f64,
+    /// Largest approach speed left at a resting contact by the resting solve [m/s].
+    resting_residual: f64,
 }
 
 impl Sim<'_, '_> {
@@ -398,14 +291,18 @@ impl Sim<'_, '_> {
         self.eng.version.resize(n, 0);
         self.eng.count.clear();
         self.eng.count.resize(n, 0);
-        self.speed_bound = self
-            .p
-            .velocities
-            .iter()
-            .map(|v| v.length())
-            .filter(|s| s.is_finite())
-            .fold(0.0, f64::max);
-        self.rebuild(0.0);
+        self.eng.heap.clear();
+        self.speed_bound = self.max_speed();
+        self.build_candidates();
+        self.solve_resting();
+        let fastest = self.max_speed();
+        if fastest > self.speed_bound {
+            self.speed_bound = fastest;
+            self.build_candidates();
+        }
+        for i in 0..n {
+            self.predict(i, 0.0);
+        }
         while let Some(Reverse(ev)) = self.eng.heap.pop() {
             self.handle(ev);
         }
@@ -418,13 +315,29 @@ impl Sim<'_, '_> {
         self.project();
     }
 
-    /// Rebuilds the candidate lists for the current speed bound and re-predicts everyone at `now`.
-    fn rebuild(&mut self, now: f64) {
-        let r_max = self.p.radii.iter().copied().filter(|r| r.is_finite()).fold(0.0, f64::max);
+    fn max_speed(&self) -> f64 {
+        let speeds = self.p.velocities.iter().map(|v| v.length());
+        speeds.filter(|s| s.is_finite()).fold(0.0, f64::max)
+    }
+
+    /// Candidate lists from the start positions for the current speed bound.
+    fn build_candidates(&mut self) {
+        let r_max = self
+            .p
+            .radii
+            .iter()
+            .copied()
+            .filter(|r| r.is_finite())
+            .fold(0.0, f64::max);
         let reach = 2.0 * self.speed_bound * self.h + 0.1 * r_max;
         self.eng
             .candidates
             .build(&self.eng.start, self.p.radii, self.domain, reach);
+    }
+
+    /// Rebuilds the candidate lists for the current speed bound and re-predicts everyone at `now`.
+    fn rebuild(&mut self, now: f64) {
+        self.build_candidates();
         self.eng.heap.clear();
         for i in 0..self.n() {
             self.eng.version[i] = self.eng.version[i].wrapping_add(1);
@@ -455,13 +368,33 @@ impl Sim<'_, '_> {
         let n = self.n();
         let horizon = self.h - now;
         let tol = self.cfg.approach_tolerance / self.h;
-        let (xi, vi, ri) = (self.position_at(i, now), self.p.velocities[i], self.p.radii[i]);
+        let (xi, vi, ri) = (
+            self.position_at(i, now),
+            self.p.velocities[i],
+            self.p.radii[i],
+        );
+        let rest = self.eng.resting_partners(i);
+        let rest_limit = 2.0 * self.resting_residual;
+        let defer = self.cfg.defer_slow_after;
+        let busy_i = self.eng.count[i] >= defer;
+        let slow = self.model.rest_speed;
+        let mut r = 0;
+        let mut is_resting = |code: usize| {
+            while r < rest.len() && (rest[r] as usize) < code {
+                r += 1;
+            }
+            r < rest.len() && rest[r] as usize == code
+        };
         let mut best: Option<(f64, u32, u32)> = None;
         let mut offer = |t: f64, lo: usize, hi: usize| {
             let cand = (now + t, lo as u32, hi as u32);
             let better = match best {
                 None => true,
-                Some(b) => cand.0.total_cmp(&b.0).then((cand.1, cand.2).cmp(&(b.1, b.2))).is_lt(),
+                Some(b) => cand
+                    .0
+                    .total_cmp(&b.0)
+                    .then((cand.1, cand.2).cmp(&(b.1, b.2)))
+                    .is_lt(),
             };
             if better {
                 best = Some(cand);
@@ -475,17 +408,26 @@ impl Sim<'_, '_> {
             let dx = self.domain.minimum_image(self.position_at(j, now) - xi);
             let dv = self.p.velocities[j] - vi;
             let s = ri + self.p.radii[j];
+            let resting = is_resting(j);
             if let Some(t) = sphere_sphere_toi(dx, dv, s, horizon) {
                 let d = dx + dv * t;
                 let approach = -dv.dot(d) / d.length();
-                if approach > tol * s {
+                let busy = busy_i || self.eng.count[j] >= defer;
+                if approach > tol * s
+                    && !(resting && approach <= rest_limit)
+                    && !(busy && approach < slow)
+                {
                     offer(t, i.min(j), i.max(j));
                 }
             }
         }
         for (w, plane) in self.domain.planes.iter().enumerate() {
+            let approach = -vi.dot(plane.normal);
+            let resting = is_resting(n + w);
             if let Some(t) = sphere_plane_toi(xi, vi, ri, plane, horizon)
-                && -vi.dot(plane.normal) > tol * 2.0 * ri
+                && approach > tol * 2.0 * ri
+                && !(resting && approach <= rest_limit)
+                && !(busy_i && approach < slow)
             {
                 offer(t, i, n + w);
             }
@@ -541,7 +483,9 @@ impl Sim<'_, '_> {
             (self.body(lo), RigidBody::fixed(), c, Counterpart::Wall)
         } else {
             self.advance(hi, now);
-            let dx = self.domain.minimum_image(self.p.positions[hi] - self.p.positions[lo]);
+            let dx = self
+                .domain
+                .minimum_image(self.p.positions[hi] - self.p.positions[lo]);
             let c = sphere_sphere_contact(dx, self.p.radii[lo], self.p.radii[hi]);
             let other = Counterpart::Particle {
                 diameter: 2.0 * self.p.radii[hi],
@@ -555,28 +499,32 @@ impl Sim<'_, '_> {
             self.eng.count[hi] += 1;
             self.eng.version[hi] = self.eng.version[hi].wrapping_add(1);
         }
-        let approach = -(b.point_velocity(contact.r_b) - a.point_velocity(contact.r_a)).dot(contact.normal);
-        let law: CollisionLaw =
-            self.model
-                .law(2.0 * self.p.radii[lo], self.p.densities[lo], other, approach);
+        let approach =
+            -(b.point_velocity(contact.r_b) - a.point_velocity(contact.r_a)).dot(contact.normal);
+        let law: CollisionLaw = self.model.law(
+            2.0 * self.p.radii[lo],
+            self.p.densities[lo],
+            other,
+            approach,
+        );
         if let Some(hit) = collision_impulse(&a, &b, &contact, &law) {
+            let resting = self.model.is_resting(hit.approach_speed);
             let before = a.velocity;
             self.p.velocities[lo] += hit.delta_velocity_a;
             self.p.angular_velocities[lo] += hit.delta_angular_velocity_a;
-            self.record(lo, now, before);
+            self.record(lo, now, before, resting);
             if !wall {
                 self.p.velocities[hi] += hit.delta_velocity_b;
                 self.p.angular_velocities[hi] += hit.delta_angular_velocity_b;
-                self.record(hi, now, b.velocity);
+                self.record(hi, now, b.velocity, resting);
             }
-            let resting = self.model.is_resting(hit.approach_speed);
             let st = &mut self.report.stats;
             st.events += 1;
             st.wall_events += usize::from(wall);
             st.resting += usize::from(resting);
             match hit.regime {
                 FrictionRegime::Stick => st.stick += 1,
-                FrictionRegime::Slide => st.slide += 1,
+                FrictionRegime::Slide | FrictionRegime::Frictionless => st.slide += 1,
             }
             if self.cfg.record_events {
                 self.report.events.push(CollisionEvent {
@@ -593,9 +541,11 @@ impl Sim<'_, '_> {
                     impulse: -hit.impulse,
                 });
             }
-            let fastest = self.p.velocities[lo]
-                .length()
-                .max(if wall { 0.0 } else { self.p.velocities[hi].length() });
+            let fastest = self.p.velocities[lo].length().max(if wall {
+                0.0
+            } else {
+                self.p.velocities[hi].length()
+            });
             if fastest > self.speed_bound && fastest.is_finite() {
                 self.speed_bound = 1.5 * fastest;
                 self.report.stats.rebuilds += 1;
@@ -609,67 +559,13 @@ impl Sim<'_, '_> {
         }
     }
 
-    fn record(&mut self, i: usize, time: f64, before: DVec3) {
+    fn record(&mut self, i: usize, time: f64, before: DVec3, resting: bool) {
         self.report.last_collision[i] = Some(LastCollision {
             time,
             velocity_before: before,
             velocity_after: self.p.velocities[i],
+            resting,
         });
-    }
-
-    /// Overlap-projection sweeps (see the module header); records the largest overlaps.
-    fn project(&mut self) {
-        self.report.stats.max_overlap_before_projection = self.sweep(false);
-        for _ in 0..self.cfg.projection_sweeps {
-            self.sweep(true);
-        }
-        self.report.stats.max_overlap_after_projection = if self.cfg.projection_sweeps > 0 {
-            self.sweep(false)
-        } else {
-            self.report.stats.max_overlap_before_projection
-        };
-    }
-
-    /// One pass over all candidate pairs and walls; returns the largest relative overlap seen
-    /// (before each correction) and corrects if `fix`.
-    fn sweep(&mut self, fix: bool) -> f64 {
-        let mut worst = 0.0f64;
-        let (x, r, w) = (&mut *self.p.positions, self.p.radii, self.p.inv_masses);
-        for i in 0..x.len() {
-            for &j in self.eng.candidates.of(i) {
-                let j = j as usize;
-                if j < i {
-                    continue;
-                }
-                let dx = self.domain.minimum_image(x[j] - x[i]);
-                let dist = dx.length();
-                let s = r[i] + r[j];
-                let overlap = s - dist;
-                if overlap <= 0.0 || overlap.is_nan() {
-                    continue;
-                }
-                worst = worst.max(overlap / s);
-                let wsum = w[i] + w[j];
-                if fix && wsum > 0.0 {
-                    let normal = if dist > 0.0 { dx / dist } else { DVec3::Z };
-                    x[i] -= normal * (overlap * w[i] / wsum);
-                    x[j] += normal * (overlap * w[j] / wsum);
-                }
-            }
-        }
-        for (i, xi) in x.iter_mut().enumerate() {
-            for plane in &self.domain.planes {
-                let overlap = r[i] - plane.signed_distance(*xi);
-                if overlap <= 0.0 || overlap.is_nan() {
-                    continue;
-                }
-                worst = worst.max(overlap / (2.0 * r[i]));
-                if fix && w[i] > 0.0 {
-                    *xi += plane.normal * overlap;
-                }
-            }
-        }
-        worst
     }
 }
 

@@ -8,7 +8,7 @@
 //! lever arms `r_a`, `r_b` from the centres to one common contact point
 //! ([`super::toi::ContactGeometry`]).
 //!
-//! **Relative contact velocity** (sign convention [D] of the spheroid spec §6.3, the only one that
+//! **Relative contact velocity** (sign convention \[D\] of the spheroid spec §6.3, the only one that
 //! makes 4.12 and 4.14 consistent): `v_ab = (v_b + Ω_b×r_b) − (v_a + Ω_a×r_a)`; the bodies approach
 //! iff `v_ab·n < 0`. The impulse `J` acts on *b* and `−J` on *a* (4.12):
 //! `v_b += J/m_b`, `Ω_b += I_b⁻¹(r_b×J)`, `v_a −= J/m_a`, `Ω_a −= I_a⁻¹(r_a×J)`, so
@@ -45,7 +45,8 @@
 //! * If `n·K(n + μ t) ≤ 0` (a Painlevé-type inconsistency of rigid-body Coulomb friction, impossible
 //!   for spheres where `n·K t = 0`) or `K` is singular (e.g. a body with zero inverse mass but
 //!   non-zero inverse inertia), the frictionless impulse `J = −(1 + e_n)(v⁻·n)/(n·K n) n` is used and
-//!   reported as sliding.
+//!   reported as [`FrictionRegime::Frictionless`]. The stick impulse of such bodies can also have
+//!   `J·n < 0` (it would pull); it then fails the Coulomb test and the slide branch is used.
 //!
 //! **Energy.** `ΔE = J·(v⁻ + v⁺)/2`. For spheres (any `e_n, e_t ∈ [0, 1]`, both regimes) and for any
 //! bodies with `e_n = e_t ≤ 1` in the stick regime, `ΔE ≤ 0`. For non-spherical bodies with
@@ -143,8 +144,11 @@ impl CollisionLaw {
 pub enum FrictionRegime {
     /// The sticking impulse lies inside the Coulomb cone.
     Stick,
-    /// The impulse lies on the cone (or the frictionless fallback was used).
+    /// The impulse lies on the cone.
     Slide,
+    /// The rigid-body friction problem was inconsistent (`n·K(n + μ t) ≤ 0`, Painlevé-type) or `K`
+    /// singular: the frictionless impulse was used. Never happens for spheres.
+    Frictionless,
 }
 
 /// Result of [`collision_impulse`]: the impulse and the velocity changes it causes.
@@ -277,10 +281,13 @@ pub fn collision_impulse(
             if jt.length() <= mu * jn {
                 (j, FrictionRegime::Stick)
             } else {
-                (slide_impulse(k, n, vn, v, vt, jt, e_n, mu)?, FrictionRegime::Slide)
+                slide_impulse(k, n, vn, v, vt, jt, e_n, mu)?
             }
         }
-        None => (frictionless_impulse(k, n, vn, e_n)?, FrictionRegime::Slide),
+        None => (
+            frictionless_impulse(k, n, vn, e_n)?,
+            FrictionRegime::Frictionless,
+        ),
     };
     let dvb = impulse * b.inv_mass;
     let dwb = b.inv_inertia * contact.r_b.cross(impulse);
@@ -298,6 +305,7 @@ pub fn collision_impulse(
 }
 
 /// Sliding impulse `J_n (n + μ t)` (or the frictionless fallback, see the module header).
+/// `μ = 0` counts as sliding.
 #[allow(clippy::too_many_arguments)]
 fn slide_impulse(
     k: DMat3,
@@ -308,9 +316,9 @@ fn slide_impulse(
     jt_stick: DVec3,
     e_n: f64,
     mu: f64,
-) -> Option<DVec3> {
+) -> Option<(DVec3, FrictionRegime)> {
     if mu <= 0.0 || mu.is_nan() {
-        return frictionless_impulse(k, n, vn, e_n);
+        return Some((frictionless_impulse(k, n, vn, e_n)?, FrictionRegime::Slide));
     }
     let vt_len = vt.length();
     let t = if vt_len > 1e-12 * v.length() {
@@ -321,9 +329,12 @@ fn slide_impulse(
     let dir = n + t * mu;
     let den = n.dot(k * dir);
     if den > 0.0 && den.is_finite() {
-        Some(dir * (-(1.0 + e_n) * vn / den))
+        Some((dir * (-(1.0 + e_n) * vn / den), FrictionRegime::Slide))
     } else {
-        frictionless_impulse(k, n, vn, e_n)
+        Some((
+            frictionless_impulse(k, n, vn, e_n)?,
+            FrictionRegime::Frictionless,
+        ))
     }
 }
 

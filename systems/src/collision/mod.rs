@@ -9,13 +9,15 @@
 //! * [`toi`]: analytic sphere–sphere and sphere–plane time of impact and contact frames, behind the
 //!   [`toi::CollisionShape`] extension point for spheroids.
 //! * [`domain`]: periodic axes and walls.
-//! * [`engine`]: the event-driven collision step over a whole particle set ([`CollisionEngine`]).
+//! * [`engine`]: the event-driven collision step over a whole particle set ([`CollisionEngine`]):
+//!   cell-grid candidates, a warm-started resting-contact solve, the time-ordered binary-collision
+//!   loop and an overlap projection.
 //! * `cells` (private): candidate pairs from a cell grid.
 //!
 //! Deviations from the thesis (errata and filled gaps) are listed in each module header: the
 //! momentum-conserving sign of (2.33), the inverted restitution ratios (L618/L624), the clamp of
 //! (2.36) below its threshold, the wall and unequal-sphere Stokes numbers, the rest speed, the
-//! approach tolerance, the event cap and the overlap projection.
+//! resting-contact solve, the approach tolerance, the event cap and the overlap projection.
 
 mod cells;
 pub mod domain;

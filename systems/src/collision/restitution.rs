@@ -8,7 +8,7 @@
 //! **Izard et al. correlation** (2.36):
 //! `e_eff/e_dry = (1 + ln(2η_e/d)/St) exp(−(π/2)/√(St + ln(2η_e/d)))`, `η_e` the effective roughness.
 //! Since `ln(2η_e/d) < 0`, the formula is defined only for `St > −ln(2η_e/d)` (7.42 for
-//! `η_e = 1.5 µm`, `d = 5 mm`); below that threshold `e_eff = 0` (spheres spec §3.3 [CHECK]),
+//! `η_e = 1.5 µm`, `d = 5 mm`); below that threshold `e_eff = 0` (spheres spec §3.3 \[CHECK\]),
 //! and it is clamped to `[0, e_dry]` (it never exceeds `e_dry` for `η_e < d/2` anyway).
 //! Examples (`e_dry = 0.86`, `η_e = 1.5 µm`, `d = 5 mm`): `St = 10 → e ≈ 0.084`,
 //! `St = 14 → e ≈ 0.22`.
@@ -88,7 +88,11 @@ pub fn izard_ratio(stokes: f64, roughness: f64, diameter: f64) -> f64 {
         return 0.0;
     }
     let ratio = (1.0 + l / stokes) * (-(std::f64::consts::FRAC_PI_2) / s.sqrt()).exp();
-    if ratio.is_nan() { 0.0 } else { ratio.clamp(0.0, 1.0) }
+    if ratio.is_nan() {
+        0.0
+    } else {
+        ratio.clamp(0.0, 1.0)
+    }
 }
 
 /// Normal restitution model.
@@ -189,8 +193,10 @@ pub struct CollisionModel {
     pub tangential_restitution: f64,
     /// Coulomb friction coefficient μ [-]. Default: 0.005 (L887; ch. 4 uses 0.05). Range: ≥ 0.
     pub friction: f64,
-    /// Approaches slower than this are fully inelastic, `e_n = e_t = 0` [m/s]. Default: 1e-3.
-    /// Range: ≥ 0; choose a few `|g_eff| h`.
+    /// Approaches slower than this are fully inelastic, `e_n = e_t = 0`; it is also the speed
+    /// scale of the engine's resting contacts [m/s]. Default: 0.01 (below the Izard threshold of
+    /// the default wet model for 2–5 mm spheres, so it changes no restitution there). Range: ≥ 0;
+    /// choose at least a few `|g_eff| h`.
     pub rest_speed: f64,
     /// Fluid density ρ_f [kg/m³]. Default: 1400 (Table 2.3). Range: > 0.
     pub fluid_density: f64,
@@ -207,14 +213,19 @@ impl Default for CollisionModel {
             },
             tangential_restitution: 0.0,
             friction: 0.005,
-            rest_speed: 1e-3,
+            rest_speed: 0.01,
             fluid_density: 1400.0,
             kinematic_viscosity: 5.54e-3 / 1400.0,
         }
     }
 }
 
-fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Result<(), CollisionModelError> {
+fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    range: &'static str,
+) -> Result<(), CollisionModelError> {
     if ok {
         Ok(())
     } else {
@@ -240,17 +251,34 @@ impl CollisionModel {
     pub fn validate(&self) -> Result<(), CollisionModelError> {
         let unit = |x: f64| (0.0..=1.0).contains(&x);
         match self.restitution {
-            Restitution::Dry { normal } => check("restitution.normal", normal, unit(normal), "[0, 1]")?,
+            Restitution::Dry { normal } => {
+                check("restitution.normal", normal, unit(normal), "[0, 1]")?
+            }
             Restitution::Wet {
                 dry_normal,
                 roughness,
             } => {
-                check("restitution.dry_normal", dry_normal, unit(dry_normal), "[0, 1]")?;
-                check("restitution.roughness", roughness, roughness > 0.0 && roughness.is_finite(), "(0, ∞)")?;
+                check(
+                    "restitution.dry_normal",
+                    dry_normal,
+                    unit(dry_normal),
+                    "[0, 1]",
+                )?;
+                check(
+                    "restitution.roughness",
+                    roughness,
+                    roughness > 0.0 && roughness.is_finite(),
+                    "(0, ∞)",
+                )?;
             }
         }
         let et = self.tangential_restitution;
-        check("tangential_restitution", et, (-1.0..=1.0).contains(&et), "[-1, 1]")?;
+        check(
+            "tangential_restitution",
+            et,
+            (-1.0..=1.0).contains(&et),
+            "[-1, 1]",
+        )?;
         let mu = self.friction;
         check("friction", mu, mu >= 0.0 && mu.is_finite(), "[0, ∞)")?;
         let v = self.rest_speed;
@@ -258,7 +286,12 @@ impl CollisionModel {
         let rho = self.fluid_density;
         check("fluid_density", rho, rho > 0.0 && rho.is_finite(), "(0, ∞)")?;
         let nu = self.kinematic_viscosity;
-        check("kinematic_viscosity", nu, nu > 0.0 && nu.is_finite(), "(0, ∞)")
+        check(
+            "kinematic_viscosity",
+            nu,
+            nu > 0.0 && nu.is_finite(),
+            "(0, ∞)",
+        )
     }
 
     /// Whether an approach at `approach_speed` [m/s] counts as a resting contact (fully inelastic).
@@ -398,10 +431,20 @@ mod tests {
         };
         m.validate().unwrap();
         let slow = m.law(1e-3, 1000.0, Counterpart::Wall, 0.049);
-        assert_eq!((slow.normal_restitution, slow.tangential_restitution, slow.friction), (0.0, 0.0, 0.2));
+        assert_eq!(
+            (
+                slow.normal_restitution,
+                slow.tangential_restitution,
+                slow.friction
+            ),
+            (0.0, 0.0, 0.2)
+        );
         assert!(m.is_resting(0.049) && !m.is_resting(0.05));
         let fast = m.law(1e-3, 1000.0, Counterpart::Wall, 0.05);
-        assert_eq!((fast.normal_restitution, fast.tangential_restitution), (0.9, 0.3));
+        assert_eq!(
+            (fast.normal_restitution, fast.tangential_restitution),
+            (0.9, 0.3)
+        );
     }
 
     #[test]
@@ -410,7 +453,13 @@ mod tests {
             friction: -1.0,
             ..CollisionModel::default()
         };
-        assert!(matches!(bad.validate(), Err(CollisionModelError::OutOfRange { name: "friction", .. })));
+        assert!(matches!(
+            bad.validate(),
+            Err(CollisionModelError::OutOfRange {
+                name: "friction",
+                ..
+            })
+        ));
         assert!(CollisionModel::dry(1.5, 0.0, 0.0).validate().is_err());
         let m = CollisionModel::default();
         let json = serde_json::to_string(&m).unwrap();

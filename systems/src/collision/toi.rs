@@ -142,7 +142,13 @@ pub fn sphere_sphere_toi(dx: DVec3, dv: DVec3, sum_radii: f64, horizon: f64) -> 
 /// let t = sphere_plane_toi(DVec3::new(0.0, 3.0, 0.0), DVec3::new(1.0, -2.0, 0.0), 1.0, &floor, 5.0);
 /// assert_eq!(t, Some(1.0));
 /// ```
-pub fn sphere_plane_toi(x: DVec3, v: DVec3, radius: f64, plane: &Plane, horizon: f64) -> Option<f64> {
+pub fn sphere_plane_toi(
+    x: DVec3,
+    v: DVec3,
+    radius: f64,
+    plane: &Plane,
+    horizon: f64,
+) -> Option<f64> {
     let vn = v.dot(plane.normal);
     if vn >= 0.0 || vn.is_nan() {
         return None;
@@ -321,11 +327,23 @@ mod tests {
         let d = v(10.0 - t, 1.0, 0.0).length();
         assert!((d - 2.0).abs() < 1e-14);
         // beyond the horizon
-        assert_eq!(sphere_sphere_toi(v(10.0, 0.0, 0.0), v(-4.0, 0.0, 0.0), 2.0, 1.99), None);
+        assert_eq!(
+            sphere_sphere_toi(v(10.0, 0.0, 0.0), v(-4.0, 0.0, 0.0), 2.0, 1.99),
+            None
+        );
         // separating or parallel
-        assert_eq!(sphere_sphere_toi(v(10.0, 0.0, 0.0), v(4.0, 0.0, 0.0), 2.0, 9.0), None);
-        assert_eq!(sphere_sphere_toi(v(10.0, 0.0, 0.0), v(0.0, 4.0, 0.0), 2.0, 9.0), None);
-        assert_eq!(sphere_sphere_toi(v(10.0, 0.0, 0.0), DVec3::ZERO, 2.0, 9.0), None);
+        assert_eq!(
+            sphere_sphere_toi(v(10.0, 0.0, 0.0), v(4.0, 0.0, 0.0), 2.0, 9.0),
+            None
+        );
+        assert_eq!(
+            sphere_sphere_toi(v(10.0, 0.0, 0.0), v(0.0, 4.0, 0.0), 2.0, 9.0),
+            None
+        );
+        assert_eq!(
+            sphere_sphere_toi(v(10.0, 0.0, 0.0), DVec3::ZERO, 2.0, 9.0),
+            None
+        );
     }
 
     #[test]
@@ -335,14 +353,26 @@ mod tests {
         assert!((t - 10.0).abs() < 1e-12);
         // impact parameter slightly larger: miss
         let dy = 2.0 + 1e-9;
-        assert_eq!(sphere_sphere_toi(v(10.0, dy, 0.0), v(-1.0, 0.0, 0.0), 2.0, 20.0), None);
+        assert_eq!(
+            sphere_sphere_toi(v(10.0, dy, 0.0), v(-1.0, 0.0, 0.0), 2.0, 20.0),
+            None
+        );
         // contact exactly at the end of the horizon is included, just after is not
-        assert_eq!(sphere_sphere_toi(v(3.0, 0.0, 0.0), v(-1.0, 0.0, 0.0), 2.0, 1.0), Some(1.0));
+        assert_eq!(
+            sphere_sphere_toi(v(3.0, 0.0, 0.0), v(-1.0, 0.0, 0.0), 2.0, 1.0),
+            Some(1.0)
+        );
         let late = sphere_sphere_toi(v(3.0, 0.0, 0.0), v(-1.0, 0.0, 0.0), 2.0, 1.0 - 1e-12);
         assert_eq!(late, None);
         let floor = Plane::new(DVec3::ZERO, DVec3::Y);
-        assert_eq!(sphere_plane_toi(v(0.0, 2.0, 0.0), v(0.0, -1.0, 0.0), 1.0, &floor, 1.0), Some(1.0));
-        assert_eq!(sphere_plane_toi(v(0.0, 2.0, 0.0), v(5.0, 0.0, 0.0), 1.0, &floor, 1.0), None);
+        assert_eq!(
+            sphere_plane_toi(v(0.0, 2.0, 0.0), v(0.0, -1.0, 0.0), 1.0, &floor, 1.0),
+            Some(1.0)
+        );
+        assert_eq!(
+            sphere_plane_toi(v(0.0, 2.0, 0.0), v(5.0, 0.0, 0.0), 1.0, &floor, 1.0),
+            None
+        );
     }
 
     #[test]
@@ -362,16 +392,34 @@ mod tests {
     #[test]
     fn overlapping_and_touching_pairs() {
         // overlapping, approaching: immediate
-        assert_eq!(sphere_sphere_toi(v(1.5, 0.0, 0.0), v(-1.0, 0.1, 0.0), 2.0, 1.0), Some(0.0));
+        assert_eq!(
+            sphere_sphere_toi(v(1.5, 0.0, 0.0), v(-1.0, 0.1, 0.0), 2.0, 1.0),
+            Some(0.0)
+        );
         // touching exactly, approaching: immediate
-        assert_eq!(sphere_sphere_toi(v(2.0, 0.0, 0.0), v(-1.0, 0.0, 0.0), 2.0, 1.0), Some(0.0));
+        assert_eq!(
+            sphere_sphere_toi(v(2.0, 0.0, 0.0), v(-1.0, 0.0, 0.0), 2.0, 1.0),
+            Some(0.0)
+        );
         // overlapping, separating: none
-        assert_eq!(sphere_sphere_toi(v(1.5, 0.0, 0.0), v(1.0, 0.0, 0.0), 2.0, 1.0), None);
+        assert_eq!(
+            sphere_sphere_toi(v(1.5, 0.0, 0.0), v(1.0, 0.0, 0.0), 2.0, 1.0),
+            None
+        );
         // overlapping, sliding tangentially: none
-        assert_eq!(sphere_sphere_toi(v(1.5, 0.0, 0.0), v(0.0, 1.0, 0.0), 2.0, 1.0), None);
+        assert_eq!(
+            sphere_sphere_toi(v(1.5, 0.0, 0.0), v(0.0, 1.0, 0.0), 2.0, 1.0),
+            None
+        );
         let floor = Plane::new(DVec3::ZERO, DVec3::Y);
-        assert_eq!(sphere_plane_toi(v(0.0, 0.5, 0.0), v(0.0, -1.0, 0.0), 1.0, &floor, 1.0), Some(0.0));
-        assert_eq!(sphere_plane_toi(v(0.0, 0.5, 0.0), v(0.0, 1.0, 0.0), 1.0, &floor, 1.0), None);
+        assert_eq!(
+            sphere_plane_toi(v(0.0, 0.5, 0.0), v(0.0, -1.0, 0.0), 1.0, &floor, 1.0),
+            Some(0.0)
+        );
+        assert_eq!(
+            sphere_plane_toi(v(0.0, 0.5, 0.0), v(0.0, 1.0, 0.0), 1.0, &floor, 1.0),
+            None
+        );
         // tiny closing speed from far away: the stable root form stays accurate
         let t = sphere_sphere_toi(v(1e3, 1.0, 0.0), v(-1e-12, 0.0, 0.0), 2.0, 1e20).unwrap();
         let exact = (1e3 - 3f64.sqrt()) * 1e12;

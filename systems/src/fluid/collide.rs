@@ -13,11 +13,28 @@ use super::config::ParticleFluidConfig;
 use super::systems::{FluidDomain, PendingHistoryReset, StepStart};
 use crate::collision::{CollisionEngine, CollisionModel, InverseInertia, ParticleArrays};
 
+/// What a collision does to the Basset history of the particles involved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CollisionHistory {
+    /// The thesis (eq. 2.29, L586): discard the pre-collision history and keep the collision's
+    /// jump term `(v(t_c⁻) − v(t_c⁺))/√(t − t_c)`, at every collision, resting contacts
+    /// included ("sustained contacts are sequences of collisions").
+    #[default]
+    Reset,
+    /// Keep the whole history: the collision's velocity change enters the history integral
+    /// like any other change of slip (the Basset-Boussinesq-Oseen equation through an
+    /// impulsive force).
+    Keep,
+}
+
 /// The collision model, the engine and the dense arrays (a resource).
 #[derive(Resource, Debug, Clone, Default)]
 pub struct CollisionWorkspace {
     /// Restitution, friction and rest speed.
     pub model: CollisionModel,
+    /// What collisions do to the Basset history.
+    pub history: CollisionHistory,
     /// The event-driven engine (keeps its buffers between steps).
     pub engine: CollisionEngine,
     /// Particle entities in `ParticleId` order (filled by [`init_collision_workspace`]).
@@ -32,10 +49,11 @@ pub struct CollisionWorkspace {
 }
 
 impl CollisionWorkspace {
-    /// A workspace for `model` (the engine with its default settings).
-    pub fn new(model: CollisionModel) -> Self {
+    /// A workspace for `model` and `history` (the engine with its default settings).
+    pub fn new(model: CollisionModel, history: CollisionHistory) -> Self {
         Self {
             model,
+            history,
             ..Default::default()
         }
     }
@@ -127,6 +145,9 @@ pub fn resolve_collisions(
         x.0 = ws.positions[k];
         v.0 = ws.velocities[k];
         w.0 = ws.angular[k];
+        if ws.history == CollisionHistory::Keep {
+            continue;
+        }
         if let Some(c) = report.last_collision[k] {
             reset.0 = Some((t_n + c.time, c.velocity_before - c.velocity_after));
         }

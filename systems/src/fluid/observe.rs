@@ -78,7 +78,7 @@ impl SeparationCurve {
     /// assert_eq!(c.time_to(0.02), 3.0);
     /// ```
     pub fn time_to(&self, level: f64) -> f64 {
-        match self.total.iter().rposition(|&e| !(e <= level)) {
+        match self.total.iter().rposition(|&e| e.is_nan() || e > level) {
             None => self.times.first().copied().unwrap_or(f64::NAN),
             Some(k) if k + 1 < self.times.len() => self.times[k + 1],
             Some(_) => f64::NAN,

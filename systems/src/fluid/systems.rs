@@ -276,7 +276,8 @@ pub fn track_levitation(
     let t_end = clock.time() + cfg.dt;
     let tol = cfg.levitation_tolerance;
     q.par_iter_mut().for_each(|(x, mut l)| {
-        if !((x.0.z - l.equilibrium_height).abs() <= tol) {
+        let gap = (x.0.z - l.equilibrium_height).abs();
+        if gap.is_nan() || gap > tol {
             l.last_outside = t_end;
         }
     });

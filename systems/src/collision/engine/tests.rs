@@ -85,7 +85,10 @@ fn head_on_equal_masses_exchange_velocities_at_the_right_time() {
     assert_eq!((ev.particle, ev.partner), (0, Partner::Particle(1)));
     assert!((ev.time - 0.009).abs() < 1e-15, "{}", ev.time);
     assert!((ev.approach_speed - 2.0).abs() < 1e-15);
-    assert_eq!(s.v, vec![DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)]);
+    assert_eq!(
+        s.v,
+        vec![DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)]
+    );
     assert!((s.x[0].x + 0.012).abs() < 1e-15 && (s.x[1].x - 0.012).abs() < 1e-15);
     let last = rep.last_collision[1].unwrap();
     assert_eq!(last.velocity_before, DVec3::new(-1.0, 0.0, 0.0));
@@ -129,7 +132,12 @@ fn newtons_cradle_is_a_sequence_of_binary_collisions() {
             DVec3::new(2.0, 0.0, 0.0),
             DVec3::new(-1.5, 0.0, 0.0),
         ],
-        vec![DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)],
+        vec![
+            DVec3::ZERO,
+            DVec3::ZERO,
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+        ],
         0.5,
         3.0 / (4.0 * std::f64::consts::PI * 0.125),
     );
@@ -161,7 +169,7 @@ fn collision_across_the_periodic_boundary() {
     let rep = s.step(&mut engine, &domain, &elastic(), 1e-3);
     assert_eq!(rep.stats.events, 1);
     assert!((rep.events[0].time - 5e-4).abs() < 1e-15);
-    assert_eq!(s.v, vec![DVec3::new(1.0, 0.0, 0.0), DVec3::new(-1.0, 0.0, 0.0)]);
+    assert!((s.v[0] - DVec3::X).length() < 1e-15 && (s.v[1] + DVec3::X).length() < 1e-15);
     // unwrapped: both back where they started
     assert!((s.x[0].x - 0.0015).abs() < 1e-15 && (s.x[1].x - 0.0085).abs() < 1e-15);
 }
@@ -172,7 +180,12 @@ fn dropped_sphere_comes_to_rest_on_the_wall() {
     let floor = Plane::new(DVec3::ZERO, DVec3::Y);
     let domain = CollisionDomain::unbounded().with_plane(floor);
     let model = CollisionModel::dry(0.8, 0.3, 3.0 * g * h);
-    let mut s = Spheres::new(vec![DVec3::new(0.0, 0.01, 0.0)], vec![DVec3::new(0.02, 0.0, 0.0)], r, 2500.0);
+    let mut s = Spheres::new(
+        vec![DVec3::new(0.0, 0.01, 0.0)],
+        vec![DVec3::new(0.02, 0.0, 0.0)],
+        r,
+        2500.0,
+    );
     let m = 1.0 / s.inv_m[0];
     let energy = |s: &Spheres| s.kinetic_energy() + m * g * s.x[0].y;
     let e0 = energy(&s);
@@ -181,16 +194,27 @@ fn dropped_sphere_comes_to_rest_on_the_wall() {
     for step in 0..2000 {
         s.v[0].y -= g * h;
         let rep = s.step(&mut engine, &domain, &model, h);
-        assert!(s.x[0].y - r >= -1e-12 * r, "penetration {} at step {step}", s.x[0].y - r);
-        assert!(energy(&s) <= e0 * (1.0 + 1e-12), "energy gain at step {step}");
+        assert!(
+            s.x[0].y - r >= -1e-12 * r,
+            "penetration {} at step {step}",
+            s.x[0].y - r
+        );
+        assert!(
+            energy(&s) <= e0 * (1.0 + 1e-12),
+            "energy gain at step {step}"
+        );
         if rep.stats.resting > 0 && rest_since.is_none() {
             rest_since = Some(step);
         }
-        if let Some(k) = rest_since {
-            if step > k + 5 {
-                assert!((s.x[0].y - r).abs() <= 1e-12 * r, "jitter {} at step {step}", s.x[0].y - r);
-                assert_eq!(s.v[0].y, 0.0);
-            }
+        if let Some(k) = rest_since
+            && step > k + 5
+        {
+            assert!(
+                (s.x[0].y - r).abs() <= 1e-12 * r,
+                "jitter {} at step {step}",
+                s.x[0].y - r
+            );
+            assert_eq!(s.v[0].y, 0.0);
         }
     }
     assert!(rest_since.unwrap() < 1000);
@@ -232,7 +256,13 @@ fn invalid_input_is_an_error() {
         densities: &s.rho,
     };
     let err = engine.step(arrays, &CollisionDomain::unbounded(), &elastic(), 1e-3);
-    assert!(matches!(err, Err(CollisionError::LengthMismatch { name: "densities", .. })));
+    assert!(matches!(
+        err,
+        Err(CollisionError::LengthMismatch {
+            name: "densities",
+            ..
+        })
+    ));
     s.rho.push(1000.0);
     let arrays = ParticleArrays {
         positions: &mut s.x,
@@ -288,17 +318,10 @@ fn settle(
         tangential_restitution: 0.0,
         ..CollisionModel::dry(0.5, 0.3, 5.0 * g * h)
     };
-    let mut cfg = EngineConfig {
+    let mut engine = CollisionEngine::new(EngineConfig {
         record_events: check,
         ..EngineConfig::default()
-    };
-    if let Ok(v) = std::env::var("BED_CFG") {
-        let f: Vec<f64> = v.split(',').map(|x| x.parse().unwrap()).collect();
-        cfg.approach_tolerance = f[0];
-        cfg.max_events_per_particle = f[1] as u32;
-        cfg.projection_sweeps = f[2] as u32;
-    }
-    let mut engine = CollisionEngine::new(cfg);
+    });
     let mut total = CollisionStats::default();
     let mut kinetic = Vec::with_capacity(steps);
     for step in 0..steps {
@@ -316,14 +339,14 @@ fn settle(
         total.capped_particles += st.capped_particles;
         total.skipped_events += st.skipped_events;
         total.rebuilds += st.rebuilds;
+        total.resting_contacts += st.resting_contacts;
+        total.resting_sweeps += st.resting_sweeps;
+        total.projection_sweeps += st.projection_sweeps;
         let worst = st.max_overlap_before_projection;
         total.max_overlap_before_projection = total.max_overlap_before_projection.max(worst);
         let worst = st.max_overlap_after_projection;
         total.max_overlap_after_projection = total.max_overlap_after_projection.max(worst);
         kinetic.push(s.kinetic_energy());
-        if std::env::var("BED_TRACE").is_ok() {
-            println!("{step} {:?} KE {:.3e}", st, s.kinetic_energy());
-        }
         if check {
             let (p1, scale) = s.momentum();
             let from_walls: DVec3 = rep
@@ -333,12 +356,20 @@ fn settle(
                 .map(|e| e.impulse)
                 .sum();
             let err = (p1 - p0 - from_walls).length();
-            assert!(err <= 1e-12 * scale.max(1e-30), "momentum bookkeeping {err:e} at step {step}");
-            let lowest = s.x.iter().zip(&s.r).map(|(x, r)| x.y - r).fold(f64::INFINITY, f64::min);
-            assert!(lowest >= -1e-12 * s.r[0], "below the floor by {lowest:e} at step {step}");
-            if std::env::var("BED_CFG").is_err() {
-                assert!(worst < 1e-3, "overlap {worst:e} d at step {step}");
-            }
+            assert!(
+                err <= 1e-12 * scale.max(1e-30),
+                "momentum bookkeeping {err:e} at step {step}"
+            );
+            let lowest =
+                s.x.iter()
+                    .zip(&s.r)
+                    .map(|(x, r)| x.y - r)
+                    .fold(f64::INFINITY, f64::min);
+            assert!(
+                lowest >= -1e-12 * s.r[0],
+                "below the floor by {lowest:e} at step {step}"
+            );
+            assert!(worst < 1e-3, "overlap {worst:e} d at step {step}");
         }
     }
     (total, kinetic)
@@ -395,5 +426,111 @@ fn throughput_dense_settling_bed() {
         (n * 200) as f64 / dt,
         stats.events as f64 / 200.0,
         kinetic.last().unwrap()
+    );
+}
+
+#[test]
+fn a_resting_column_neither_sinks_nor_jitters() {
+    let (r, g, h) = (1e-3, 9.81, 2.5e-4);
+    let domain = CollisionDomain::unbounded().with_plane(Plane::new(DVec3::ZERO, DVec3::Y));
+    let model = CollisionModel::dry(0.5, 0.3, 5.0 * g * h);
+    let x: Vec<DVec3> = (0..10)
+        .map(|k| DVec3::new(0.0, r * (1.0 + 2.0 * k as f64), 0.0))
+        .collect();
+    let mut s = Spheres::new(x.clone(), vec![DVec3::ZERO; 10], r, 2500.0);
+    let mut engine = CollisionEngine::new(EngineConfig::default());
+    let mut sweeps = Vec::new();
+    for step in 0..400 {
+        for v in &mut s.v {
+            v.y -= g * h;
+        }
+        let rep = s.step(&mut engine, &domain, &model, h);
+        sweeps.push(rep.stats.resting_sweeps);
+        assert_eq!(rep.stats.resting_contacts, 10);
+        assert!(
+            rep.stats.max_overlap_after_projection < 5e-4,
+            "{:?}",
+            rep.stats
+        );
+        assert!(s.x[0].y >= r * (1.0 - 1e-12));
+        if step >= 10 {
+            assert_eq!(rep.stats.events, 0, "step {step}");
+            for (k, (a, b)) in s.x.iter().zip(&x).enumerate() {
+                assert!(
+                    (a.y - b.y).abs() < 2e-4 * r,
+                    "sphere {k} moved {:e} at step {step}",
+                    a.y - b.y
+                );
+            }
+            let fastest = s.v.iter().map(|v| v.length()).fold(0.0, f64::max);
+            // what is left: the solve's tolerance and speculative closing of projection gaps
+            assert!(
+                fastest < 0.25 * g * h,
+                "residual speed {fastest:e} at step {step}"
+            );
+        }
+    }
+    // the warm start makes the steady column converge in a few sweeps, not O(height²)
+    let late = &sweeps[10..];
+    let mean = late.iter().sum::<usize>() as f64 / late.len() as f64;
+    let worst = late.iter().copied().max().unwrap();
+    println!(
+        "resting sweeps: first {:?}, after step 10: mean {mean:.1}, max {worst}",
+        &sweeps[..5]
+    );
+    assert!(mean < 5.0 && worst < 100);
+}
+
+/// Throughput of a dilute suspension like the thesis runs (Φ = 0.02, 10⁴ spheres of 4 mm in a
+/// triply periodic box, random velocities of 0.05 m/s, wet default model, no gravity).
+#[test]
+#[ignore]
+fn throughput_dilute_suspension() {
+    let (n, r, phi): (usize, f64, f64) = (10_000, 2e-3, 0.02);
+    let len = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) / phi).cbrt();
+    let domain = (0..3).fold(CollisionDomain::unbounded(), |d, k| {
+        d.with_periodic(k, 0.0, len)
+    });
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+    let mut x: Vec<DVec3> = Vec::with_capacity(n);
+    while x.len() < n {
+        let p = DVec3::new(
+            rng.random_range(0.0..len),
+            rng.random_range(0.0..len),
+            rng.random_range(0.0..len),
+        );
+        if x.iter()
+            .all(|q| domain.minimum_image(p - *q).length() > 2.0 * r)
+        {
+            x.push(p);
+        }
+    }
+    let v = (0..n)
+        .map(|_| {
+            DVec3::new(
+                rng.random_range(-0.05..0.05),
+                rng.random_range(-0.05..0.05),
+                rng.random_range(-0.05..0.05),
+            )
+        })
+        .collect();
+    let mut s = Spheres::new(x, v, r, 1400.0);
+    let model = CollisionModel::default();
+    let mut engine = CollisionEngine::new(EngineConfig {
+        record_events: false,
+        ..EngineConfig::default()
+    });
+    let steps = 200;
+    let t0 = std::time::Instant::now();
+    let mut events = 0;
+    for _ in 0..steps {
+        events += s.step(&mut engine, &domain, &model, 9e-4).stats.events;
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    println!(
+        "dilute {n} spheres, Φ = {phi}, h = 0.9 ms, {steps} steps: {:.3e} particle-steps/s \
+         ({dt:.2} s), {:.1} collisions/step",
+        (n * steps) as f64 / dt,
+        events as f64 / steps as f64
     );
 }

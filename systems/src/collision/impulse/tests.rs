@@ -39,7 +39,10 @@ struct Body {
 
 fn random_body(rng: &mut Rng) -> Body {
     let mass = rng.random_range(0.2..5.0);
-    let rot = DMat3::from_quat(DQuat::from_axis_angle(unit(rng), rng.random_range(0.0..6.3)));
+    let rot = DMat3::from_quat(DQuat::from_axis_angle(
+        unit(rng),
+        rng.random_range(0.0..6.3),
+    ));
     let principal = DVec3::new(
         rng.random_range(0.05..2.0),
         rng.random_range(0.05..2.0),
@@ -121,7 +124,7 @@ fn random_law(rng: &mut Rng) -> CollisionLaw {
 #[test]
 fn general_bodies_conserve_momentum_and_meet_restitution_and_coulomb() {
     let mut rng = Rng::seed_from_u64(11);
-    let (mut sticks, mut slides) = (0, 0);
+    let (mut sticks, mut slides, mut fallbacks) = (0, 0, 0);
     let (mut worst_p, mut worst_l, mut worst_e) = (0.0f64, 0.0f64, 0.0f64);
     for _ in 0..20_000 {
         let (a, b, contact) = random_collision(&mut rng);
@@ -154,11 +157,25 @@ fn general_bodies_conserve_momentum_and_meet_restitution_and_coulomb() {
             }
             FrictionRegime::Slide => {
                 slides += 1;
-                assert!((jt - law.friction * jn).abs() <= 1e-12 * jn, "{jt} vs {}", law.friction * jn);
+                assert!(
+                    (jt - law.friction * jn).abs() <= 1e-12 * jn,
+                    "{jt} vs {}",
+                    law.friction * jn
+                );
+            }
+            FrictionRegime::Frictionless => {
+                fallbacks += 1;
+                assert!(jt <= 1e-12 * jn);
+                let k = collision_matrix(&a.body, &b.body, &contact);
+                let vt = vm - n * vm.dot(n);
+                let t = -vt.normalize();
+                assert!(n.dot(k * (n + t * law.friction)) <= 0.0);
             }
         }
     }
-    println!("sticks {sticks} slides {slides}, worst |dP|/scale {worst_p:.2e}, |dL| {worst_l:.2e}, e {worst_e:.2e}");
+    println!(
+        "sticks {sticks} slides {slides} frictionless fallbacks {fallbacks}, worst |dP|/scale {worst_p:.2e}, |dL| {worst_l:.2e}, e {worst_e:.2e}"
+    );
     assert!(sticks > 1000 && slides > 1000);
     assert!(worst_p < 1e-14 && worst_l < 1e-14, "{worst_p} {worst_l}");
 }
@@ -236,7 +253,12 @@ fn spheres_reduce_to_hoomans_and_never_gain_energy() {
             -n,
             &law,
         );
-        let ours = [pa.velocity, pa.angular_velocity, pb.velocity, pb.angular_velocity];
+        let ours = [
+            pa.velocity,
+            pa.angular_velocity,
+            pb.velocity,
+            pb.angular_velocity,
+        ];
         let scale = sa.velocity.length() + sb.velocity.length() + sa.angular_velocity.length() * ra;
         for (o, h) in ours.iter().zip(&h) {
             worst = worst.max((*o - *h).length() / scale);
@@ -245,8 +267,14 @@ fn spheres_reduce_to_hoomans_and_never_gain_energy() {
             0.5 * m * s.velocity.length_squared()
                 + 0.2 * m * r * r * s.angular_velocity.length_squared()
         };
-        let (e0, e1) = (e(&sa, ma, ra) + e(&sb, mb, rb), e(&pa, ma, ra) + e(&pb, mb, rb));
-        assert!(e1 <= e0 * (1.0 + 1e-13), "energy gain {e0} -> {e1}, {law:?}");
+        let (e0, e1) = (
+            e(&sa, ma, ra) + e(&sb, mb, rb),
+            e(&pa, ma, ra) + e(&pb, mb, rb),
+        );
+        assert!(
+            e1 <= e0 * (1.0 + 1e-13),
+            "energy gain {e0} -> {e1}, {law:?}"
+        );
     }
     println!("max deviation from Hoomans: {worst:.2e}");
     assert!(worst < 1e-12, "{worst}");
@@ -264,10 +292,16 @@ fn general_bodies_with_equal_restitutions_never_gain_energy() {
             friction: 1e6,
         };
         let hit = collision_impulse(&a.body, &b.body, &contact, &law).unwrap();
-        assert_eq!(hit.regime, FrictionRegime::Stick);
+        if hit.regime != FrictionRegime::Stick {
+            // the stick impulse would pull (J·n < 0): only possible for eccentric contacts
+            continue;
+        }
         let (mut sa, mut sb) = (a.body, b.body);
         hit.apply(&mut sa, &mut sb);
-        let (e0, e1) = (energy(&[&a, &b], &[a.body, b.body]), energy(&[&a, &b], &[sa, sb]));
+        let (e0, e1) = (
+            energy(&[&a, &b], &[a.body, b.body]),
+            energy(&[&a, &b], &[sa, sb]),
+        );
         assert!(e1 <= e0 * (1.0 + 1e-13) + 1e-15, "{e0} -> {e1}");
         // ΔE = J·(v⁻ + v⁺)/2 = −(1 − e²)/2 v⁻ᵀK⁻¹v⁻
         let vm = relative_contact_velocity(&a.body, &b.body, &contact);
@@ -374,9 +408,14 @@ fn sliding_sphere_on_wall_ends_rolling_with_two_sevenths_impulse() {
     assert_eq!(wall, RigidBody::fixed());
     // rolling: the contact point is at rest tangentially, ω × (−r ŷ) = −v_t
     let contact_v = after.point_velocity(-DVec3::Y * r);
-    assert!(contact_v.x.abs() < 1e-15 && contact_v.z.abs() < 1e-15, "{contact_v}");
+    assert!(
+        contact_v.x.abs() < 1e-15 && contact_v.z.abs() < 1e-15,
+        "{contact_v}"
+    );
     assert!((after.velocity.y - 0.6 * 0.9).abs() < 1e-15);
-    assert!(((after.angular_velocity * r).length() - after.velocity.with_y(0.0).length()).abs() < 1e-15);
+    assert!(
+        ((after.angular_velocity * r).length() - after.velocity.with_y(0.0).length()).abs() < 1e-15
+    );
     assert!((after.velocity.with_y(0.0) - vt * (5.0 / 7.0)).length() < 1e-15);
     // small friction: slides with |J_t| = μ J_n exactly, the wall takes the momentum
     let slippery = CollisionLaw {

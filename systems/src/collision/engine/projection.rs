@@ -1,0 +1,103 @@
+//! Position projection after the event loop (a safety net, not physics; see the engine header):
+//! Gauss–Seidel sweeps over the candidate pairs, then the walls, that push overlapping pairs apart
+//! along the centre line, split by inverse mass (walls and zero-inverse-mass particles immovable),
+//! until no overlap exceeds `projection_tolerance` or `projection_sweeps` sweeps are done. The
+//! sweep direction alternates (symmetric Gauss–Seidel); a forward sweep, which treats the walls
+//! last, ends the projection when the budget allows, so that no particle is left in a wall.
+
+use glam::DVec3;
+
+use super::Sim;
+
+impl Sim<'_, '_> {
+    /// Overlap-projection sweeps (see the module header); records the largest overlaps.
+    pub(super) fn project(&mut self) {
+        let max = self.cfg.projection_sweeps as usize;
+        let before = self.sweep(max > 0, false);
+        let mut worst = before;
+        let mut sweeps = usize::from(max > 0);
+        while sweeps < max && worst > self.cfg.projection_tolerance {
+            worst = self.sweep(true, sweeps % 2 == 1);
+            sweeps += 1;
+        }
+        // end with a forward sweep (walls last), even one past the budget
+        if sweeps % 2 == 0 && worst > 0.0 {
+            self.sweep(true, false);
+            sweeps += 1;
+        }
+        let after = if max > 0 {
+            self.sweep(false, false)
+        } else {
+            before
+        };
+        let st = &mut self.report.stats;
+        st.max_overlap_before_projection = before;
+        st.projection_sweeps = sweeps;
+        st.max_overlap_after_projection = after;
+    }
+
+    /// One pass over all candidate pairs and walls (forward: pairs in index order, then walls;
+    /// backward: walls, then pairs in reverse order); returns the largest relative overlap seen
+    /// (before each correction) and corrects if `fix`.
+    fn sweep(&mut self, fix: bool, backward: bool) -> f64 {
+        let n = self.n();
+        let mut worst = 0.0f64;
+        if backward {
+            worst = worst.max(self.sweep_walls(fix, true));
+        }
+        for k in 0..n {
+            let i = if backward { n - 1 - k } else { k };
+            let m = self.eng.candidates.of(i).len();
+            for q in 0..m {
+                let j = self.eng.candidates.of(i)[if backward { m - 1 - q } else { q }] as usize;
+                if j > i {
+                    worst = worst.max(self.separate(i, j, fix));
+                }
+            }
+        }
+        if !backward {
+            worst = worst.max(self.sweep_walls(fix, false));
+        }
+        worst
+    }
+
+    /// Corrects (if `fix`) and returns the relative overlap of the pair `(i, j)`.
+    fn separate(&mut self, i: usize, j: usize, fix: bool) -> f64 {
+        let (x, r, w) = (&mut *self.p.positions, self.p.radii, self.p.inv_masses);
+        let dx = self.domain.minimum_image(x[j] - x[i]);
+        let dist = dx.length();
+        let s = r[i] + r[j];
+        let overlap = s - dist;
+        if overlap <= 0.0 || overlap.is_nan() {
+            return 0.0;
+        }
+        let wsum = w[i] + w[j];
+        if fix && wsum > 0.0 {
+            let normal = if dist > 0.0 { dx / dist } else { DVec3::Z };
+            x[i] -= normal * (overlap * w[i] / wsum);
+            x[j] += normal * (overlap * w[j] / wsum);
+        }
+        overlap / s
+    }
+
+    /// Particle–wall pass; returns the largest relative overlap seen.
+    fn sweep_walls(&mut self, fix: bool, backward: bool) -> f64 {
+        let mut worst = 0.0f64;
+        let (x, r, w) = (&mut *self.p.positions, self.p.radii, self.p.inv_masses);
+        let n = x.len();
+        for k in 0..n {
+            let i = if backward { n - 1 - k } else { k };
+            for plane in &self.domain.planes {
+                let overlap = r[i] - plane.signed_distance(x[i]);
+                if overlap <= 0.0 || overlap.is_nan() {
+                    continue;
+                }
+                worst = worst.max(overlap / (2.0 * r[i]));
+                if fix && w[i] > 0.0 {
+                    x[i] += plane.normal * overlap;
+                }
+            }
+        }
+        worst
+    }
+}
