@@ -2,6 +2,7 @@
 //! full-memory history, the thesis's levitation numbers, and where explicit stepping fails.
 
 use super::*;
+use crate::fluid::history::{HistoryPlan, HistoryState};
 use crate::fluid::levitation::levitation_time;
 use crate::fluid::stokes_reference::StokesRelease;
 
@@ -236,4 +237,41 @@ fn large_time_steps_break_explicit_drag_but_not_the_implicit_step() {
             s.static_force(-0.5 * 0.075) / (3.0 * std::f64::consts::PI * s.liquid.viscosity * d);
         assert!((v / stokes - 1.0).abs() < 0.05, "dt {dt}: {v} vs {stokes}");
     }
+}
+
+#[test]
+fn the_thesis_reset_leaves_a_memory_of_the_pre_collision_slip() {
+    // eq. 2.29 keeps the jump (v(t_c⁻) − v(t_c⁺))/√(t − t_c) but drops what came before, so
+    // once the particle is at rest, I(t) √(t − t_c) → −w(t_c⁻): a force c_H w(t_c⁻)/√(t − t_c)
+    // that decays only like t^(−1/2). Keeping the whole history, the memory of the approach
+    // and of the jump cancel and I(t) decays like t^(−3/2)·…, much faster.
+    let dt = 1e-3;
+    let plan = HistoryPlan::new(dt, HistoryKernel::window(0.2, dt, true)).unwrap();
+    let w_before = DVec3::new(0.0, 0.0, -0.02); // slip just before the collision
+    let (mut reset, mut keep) = (
+        HistoryState::new(DVec3::ZERO, 0.0),
+        HistoryState::new(DVec3::ZERO, 0.0),
+    );
+    // accelerate from rest to the pre-collision slip over 1 s
+    for n in 1..=1000 {
+        let w = w_before * (n as f64 / 1000.0);
+        reset.push(&plan, w);
+        keep.push(&plan, w);
+    }
+    // the collision stops the particle at t_c = 1 s (slip 0 afterwards)
+    let t_c = 1.0;
+    reset.reset_at_collision(&plan, t_c, DVec3::ZERO - w_before, DVec3::ZERO, t_c);
+    keep.push(&plan, DVec3::ZERO);
+    for _ in 0..(99_000 - 1) {
+        reset.push(&plan, DVec3::ZERO);
+        keep.push(&plan, DVec3::ZERO);
+    }
+    let t = 100.0;
+    let scaled_reset = reset.current_integral(&plan, t) * (t - t_c).sqrt();
+    let scaled_keep = keep.current_integral(&plan, t) * (t - t_c).sqrt();
+    assert!((scaled_reset + w_before).length() < 1e-9, "{scaled_reset}");
+    assert!(
+        scaled_keep.length() < 0.02 * w_before.length(),
+        "{scaled_keep}"
+    );
 }
