@@ -213,3 +213,36 @@ fn levitation_time_kernel_matches_the_pipeline_bookkeeping() {
         "pipeline {tp}, kernel {tl}"
     );
 }
+
+#[test]
+fn shipped_particle_fluid_scenes_run() {
+    // every shipped particle_fluid scene spawns, runs two steps and summarises
+    let mut n = 0;
+    for entry in std::fs::read_dir("scenes").unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        if !text.contains("pipeline = \"particle_fluid\"") {
+            continue;
+        }
+        let dt = scene(&text).particle_fluid.unwrap().section.time_step;
+        let short = with_duration(&text, 2.0 * dt);
+        let (_, summary) = run(&short, RunOptions::default());
+        assert_eq!(summary["steps"], 2, "{}", path.display());
+        n += 1;
+    }
+    assert!(n >= 8, "{n} particle_fluid scenes");
+}
+
+/// The scene text with its `duration = ...` line replaced.
+fn with_duration(text: &str, duration: f64) -> String {
+    text.lines()
+        .map(|l| {
+            if l.trim_start().starts_with("duration =") {
+                format!("duration = {duration}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}

@@ -8,7 +8,11 @@
 //!   memory and for the thesis's window (0.35 s at Δt = 0.9 ms = 389 steps, with the
 //!   exponential tail), for one particle and per particle for 1000 particles sharing a plan;
 //! * [`pipeline_row`]: particle-steps per second of the whole pipeline on
-//!   `scenes/levitation_single.toml` (`load_scene` + [`Simulation`], default executor).
+//!   `scenes/levitation_single.toml` (`load_scene` + [`Simulation`], default executor);
+//! * [`collision_bed_row`]: particle-steps per second of the pipeline with collisions in a
+//!   dense settling bed of 10⁴ glass spheres (1 mm, in water, no magnet) on the floor of a
+//!   periodic channel: first while the bed forms, then once it rests (every particle in
+//!   sustained contact).
 //!
 //! History timings are minima over repetitions (the machine is shared), single-threaded.
 
@@ -129,8 +133,7 @@ pub fn bench_particle_fluid(as_json: bool, quick: bool) -> Result<(), BenchError
     let mut rows = Vec::new();
     history_rows(&mut rows, as_json, quick)?;
     pipeline_row(&mut rows, as_json, quick)?;
-    // A row for collisions in a dense settling bed goes here: a `fn collision_bed_row(rows,
-    // as_json, quick) -> Result<(), BenchError>` emitting its own measurement(s).
+    collision_bed_row(&mut rows, as_json, quick)?;
     Ok(())
 }
 
@@ -213,5 +216,75 @@ fn pipeline_row(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(),
                "seconds_per_step": wall / steps.max(1) as f64,
                "levitation_time_s": levitation_time}),
     );
+    Ok(())
+}
+
+/// A dense settling bed: `n` 1 mm glass spheres (2500 kg/m³) in water, dropped from a box of
+/// volume fraction 0.3 onto the floor of a channel periodic in x and y, all terms on (history
+/// window 0.05 s), collisions with the thesis's wet restitution.
+fn settling_bed_scene(n: u64) -> String {
+    // about 10 layers: side² · 10 d · 0.6 = n V_p
+    let d: f64 = 1e-3;
+    let side = ((n as f64) * std::f64::consts::PI * d.powi(3) / 6.0 / (0.6 * 10.0 * d)).sqrt();
+    let top = (n as f64) * std::f64::consts::PI * d.powi(3) / 6.0 / (0.3 * side * side);
+    format!(
+        r#"
+[simulation]
+pipeline = "particle_fluid"
+[particle_fluid]
+time_step = 1e-3
+duration = 100.0
+history = {{ kind = "window", window = 0.05 }}
+observe_every = 1000000
+[liquid]
+density = 1000.0
+viscosity = 1e-3
+[container]
+kind = "channel"
+side = [{side}, {side}]
+height = {height}
+[[particles]]
+count = {n}
+shape = {{ kind = "sphere", radius = 0.5e-3 }}
+density = 2500.0
+placement = {{ kind = "box", min = [0.0005, 0.0005, 0.0005], max = [{m}, {m}, {top}] }}
+"#,
+        height = top + 2.0 * d,
+        m = side - 0.0005,
+        top = top + 0.0005,
+    )
+}
+
+/// Particle-steps per second with collisions in a dense settling bed (10⁴ spheres; quick:
+/// 10³), over the first steps (the bed forming) and over later steps (resting contacts).
+fn collision_bed_row(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(), BenchError> {
+    let n: u64 = if quick { 1_000 } else { 10_000 };
+    let scene = parse_scene(&settling_bed_scene(n), &SceneRegistry::default())
+        .map_err(|e| BenchError::Runtime(format!("settling bed scene: {e}")))?;
+    let mut sim = Simulation::from_scene(&scene, RunOptions::default())
+        .map_err(|e| BenchError::Runtime(format!("bench simulation: {e}")))?;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let phases: &[(&str, u64)] = if quick {
+        &[("forming", 50), ("resting", 50)]
+    } else {
+        &[("forming", 300), ("settling", 700), ("resting", 300)]
+    };
+    for (phase, steps) in phases {
+        let start = Instant::now();
+        for _ in 0..*steps {
+            sim.step();
+        }
+        let wall = start.elapsed().as_secs_f64();
+        let s = sim.summary();
+        emit(
+            rows,
+            as_json,
+            json!({"name": "particle_fluid_settling_bed", "phase": phase, "threads": threads,
+                   "particles": n, "steps": steps, "simulated_time_s": s["simulated_time"],
+                   "wall_time_s": wall,
+                   "particle_steps_per_s": (n * steps) as f64 / wall.max(1e-12),
+                   "collisions_so_far": s["collisions"]}),
+        );
+    }
     Ok(())
 }
