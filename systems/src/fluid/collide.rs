@@ -138,6 +138,8 @@ pub fn resolve_collisions(
         }
     };
     let t_n = clock.time();
+    // the end of this step, as the next step's history system computes it (step * dt)
+    let t_end = (clock.step + 1) as f64 * clock.dt;
     for (k, &e) in ws.order.iter().enumerate() {
         let Ok((_, _, _, mut x, mut v, mut w, mut reset)) = q.get_mut(e) else {
             continue;
@@ -149,7 +151,8 @@ pub fn resolve_collisions(
             continue;
         }
         if let Some(c) = report.last_collision[k] {
-            reset.0 = Some((t_n + c.time, c.velocity_before - c.velocity_after));
+            let t_c = (t_n + c.time).min(t_end);
+            reset.0 = Some((t_c, c.velocity_before - c.velocity_after));
         }
     }
     let s = &report.stats;

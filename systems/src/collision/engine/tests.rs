@@ -402,33 +402,6 @@ fn steps_are_bitwise_deterministic() {
     assert_eq!(a, b);
 }
 
-/// Throughput of a dense settling bed of 10⁴ spheres (run in release with `--ignored --nocapture`).
-#[test]
-#[ignore]
-fn throughput_dense_settling_bed() {
-    let n = 10_000;
-    let (mut s, domain) = bed(n, 30, 1e-3, 5);
-    let h = 2.5e-4;
-    // settle first (not timed), then time steps of the dense bed
-    let t0 = std::time::Instant::now();
-    let (stats, _) = settle(&mut s, &domain, 500, h, false);
-    let dt = t0.elapsed().as_secs_f64();
-    println!(
-        "settling {n} spheres, 500 steps: {:.3e} particle-steps/s ({dt:.2} s), {stats:?}",
-        (n * 500) as f64 / dt
-    );
-    let t0 = std::time::Instant::now();
-    let (stats, kinetic) = settle(&mut s, &domain, 200, h, false);
-    let dt = t0.elapsed().as_secs_f64();
-    println!(
-        "settled bed {n} spheres, 200 steps: {:.3e} particle-steps/s ({dt:.2} s), events/step {:.0}, \
-         final KE {:.3e} J, {stats:?}",
-        (n * 200) as f64 / dt,
-        stats.events as f64 / 200.0,
-        kinetic.last().unwrap()
-    );
-}
-
 #[test]
 fn a_resting_column_neither_sinks_nor_jitters() {
     let (r, g, h) = (1e-3, 9.81, 2.5e-4);
@@ -481,56 +454,3 @@ fn a_resting_column_neither_sinks_nor_jitters() {
     assert!(mean < 5.0 && worst < 100);
 }
 
-/// Throughput of a dilute suspension like the thesis runs (Φ = 0.02, 10⁴ spheres of 4 mm in a
-/// triply periodic box, random velocities of 0.05 m/s, wet default model, no gravity).
-#[test]
-#[ignore]
-fn throughput_dilute_suspension() {
-    let (n, r, phi): (usize, f64, f64) = (10_000, 2e-3, 0.02);
-    let len = (n as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) / phi).cbrt();
-    let domain = (0..3).fold(CollisionDomain::unbounded(), |d, k| {
-        d.with_periodic(k, 0.0, len)
-    });
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
-    let mut x: Vec<DVec3> = Vec::with_capacity(n);
-    while x.len() < n {
-        let p = DVec3::new(
-            rng.random_range(0.0..len),
-            rng.random_range(0.0..len),
-            rng.random_range(0.0..len),
-        );
-        if x.iter()
-            .all(|q| domain.minimum_image(p - *q).length() > 2.0 * r)
-        {
-            x.push(p);
-        }
-    }
-    let v = (0..n)
-        .map(|_| {
-            DVec3::new(
-                rng.random_range(-0.05..0.05),
-                rng.random_range(-0.05..0.05),
-                rng.random_range(-0.05..0.05),
-            )
-        })
-        .collect();
-    let mut s = Spheres::new(x, v, r, 1400.0);
-    let model = CollisionModel::default();
-    let mut engine = CollisionEngine::new(EngineConfig {
-        record_events: false,
-        ..EngineConfig::default()
-    });
-    let steps = 200;
-    let t0 = std::time::Instant::now();
-    let mut events = 0;
-    for _ in 0..steps {
-        events += s.step(&mut engine, &domain, &model, 9e-4).stats.events;
-    }
-    let dt = t0.elapsed().as_secs_f64();
-    println!(
-        "dilute {n} spheres, Φ = {phi}, h = 0.9 ms, {steps} steps: {:.3e} particle-steps/s \
-         ({dt:.2} s), {:.1} collisions/step",
-        (n * steps) as f64 / dt,
-        events as f64 / steps as f64
-    );
-}
