@@ -453,4 +453,3 @@ fn a_resting_column_neither_sinks_nor_jitters() {
     );
     assert!(mean < 5.0 && worst < 100);
 }
-
