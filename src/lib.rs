@@ -40,6 +40,10 @@ pub mod prelude {
     pub use magsep_plugins::packing::{
         McmCompressionPlugin, McmOverlapRemovalPlugin, PackingObservePlugin, packing_pipeline,
     };
+    pub use magsep_plugins::particle_fluid::{
+        CollisionPlugin, InertialForcesPlugin, InertialIntegratorPlugin, SeparationObservePlugin,
+        particle_fluid_pipeline,
+    };
     pub use magsep_plugins::recorder::RecordPlugin;
     pub use magsep_systems::sets::{ForceSystems, ObserveSchedule, SimSchedule, SimSystems};
 }
