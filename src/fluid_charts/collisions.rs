@@ -17,10 +17,9 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+use super::runtime;
 use crate::bench::BenchError;
 use crate::chart::{Chart, Figure, LegendPosition, Line, Series, Style, write_svg};
-use crate::scene::parse_scene;
-use crate::sim::{RunOptions, Simulation};
 use magsep_components::prelude::*;
 
 /// The shipped scene.
@@ -37,20 +36,8 @@ struct RunOut {
     levitation: Vec<Option<f64>>,
 }
 
-fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
-}
-
 fn run(text: &str) -> Result<RunOut, BenchError> {
-    let scene = parse_scene(text, &Default::default()).map_err(runtime)?;
-    let mut sim = Simulation::from_scene(
-        &scene,
-        RunOptions {
-            single_threaded: true,
-            ..Default::default()
-        },
-    )
-    .map_err(runtime)?;
+    let mut sim = super::simulation(text)?;
     let mut out = RunOut {
         times: Vec::new(),
         heights: Vec::new(),

@@ -25,11 +25,8 @@ mod maps;
 use std::path::Path;
 use std::time::Instant;
 
-use magsep_systems::fluid::config::{ForceTerms, Integrator};
-use magsep_systems::fluid::drag::DragLaw;
 use magsep_systems::fluid::history::HistoryKernel;
 use magsep_systems::fluid::levitation::levitation_time;
-use magsep_systems::fluid::magnet::{Liquid, MagnetModel};
 use magsep_systems::fluid::single::{SphereInLiquid, Trajectory};
 use magsep_systems::fluid::stokes_reference::StokesRelease;
 use serde_json::{Value, json};
@@ -69,24 +66,7 @@ impl Setting {
 
 /// The sphere of part (a): MnCl₂ without magnet, Stokes drag, released from rest.
 fn stokes_sphere(history: HistoryKernel) -> SphereInLiquid {
-    SphereInLiquid {
-        liquid: Liquid {
-            density: 1403.0,
-            viscosity: 5.54e-3,
-            susceptibility: 0.0,
-        },
-        magnet: MagnetModel::None,
-        gravity: 9.81,
-        diameter: 2.0 * RADIUS,
-        density: DENSITY,
-        terms: ForceTerms {
-            magnetic_buoyancy: false,
-            ..ForceTerms::default()
-        },
-        drag_law: DragLaw::Stokes,
-        integrator: Integrator::Implicit,
-        history,
-    }
+    SphereInLiquid::stokes_release(RADIUS, DENSITY, history)
 }
 
 /// `f()` timed: repeated until `min_time` [s] has passed (at most 20 times); the minimum

@@ -28,6 +28,7 @@ use magsep_systems::fluid::single::{SphereInLiquid, Trajectory};
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+pub(crate) use super::runtime;
 use crate::bench::BenchError;
 use crate::chart::{Chart, Figure, Line, Series, Style, write_svg};
 
@@ -92,11 +93,6 @@ impl Sizes {
             ""
         }
     }
-}
-
-/// Map any displayable error to [`BenchError::Runtime`].
-pub(crate) fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
 }
 
 /// The table 2.1 rig with a sphere of `d` [m], history off or with the 0.2 s window + tail.

@@ -19,3 +19,26 @@ pub use collisions::chart_collisions;
 pub use history::chart_history;
 pub use levitation::chart_levitation;
 pub use separation::chart_separation;
+
+use crate::bench::BenchError;
+use crate::scene::parse_scene;
+use crate::sim::{RunOptions, Simulation};
+
+/// A run-time error of a chart or bench.
+pub(crate) fn runtime(e: impl std::fmt::Display) -> BenchError {
+    BenchError::Runtime(e.to_string())
+}
+
+/// The simulation of scene `text`, on the single-threaded executor (charts run scenes in
+/// parallel with rayon instead).
+pub(crate) fn simulation(text: &str) -> Result<Simulation, BenchError> {
+    let scene = parse_scene(text, &Default::default()).map_err(runtime)?;
+    Simulation::from_scene(
+        &scene,
+        RunOptions {
+            single_threaded: true,
+            ..Default::default()
+        },
+    )
+    .map_err(runtime)
+}

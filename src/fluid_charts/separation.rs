@@ -15,10 +15,9 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+use super::runtime;
 use crate::bench::BenchError;
 use crate::chart::{Chart, Figure, LegendPosition, Line, Series, Style, write_svg};
-use crate::scene::parse_scene;
-use crate::sim::{RunOptions, Simulation};
 use magsep_systems::fluid::observe::SeparationCurve;
 
 /// The shipped cases: (name, scene, thesis time to e_m = 0.02 [s] where stated).
@@ -46,10 +45,6 @@ const CASES: [(&str, &str, Option<f64>); 6] = [
 /// The period of the shipped channel [m] (4π L / 3).
 const SIDE: &str = "0.3141592653589793";
 
-fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
-}
-
 /// The scene text of a case, reduced in quick mode.
 fn reduced(text: &str, quick: bool, small: bool) -> String {
     if !quick {
@@ -62,15 +57,7 @@ fn reduced(text: &str, quick: bool, small: bool) -> String {
 }
 
 fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
-    let scene = parse_scene(text, &Default::default()).map_err(runtime)?;
-    let mut sim = Simulation::from_scene(
-        &scene,
-        RunOptions {
-            single_threaded: true,
-            ..Default::default()
-        },
-    )
-    .map_err(runtime)?;
+    let mut sim = super::simulation(text)?;
     let summary = sim.run(|_| {}).map_err(runtime)?;
     let curve = sim
         .app

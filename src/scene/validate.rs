@@ -118,6 +118,18 @@ pub(super) fn check(
     }
 }
 
+/// An error `only for pipeline = "<pipeline>"` at `<path>.<key>` for every present key.
+fn reject_keys(errors: &mut Vec<SceneError>, path: &str, keys: &[(&str, bool)], pipeline: &str) {
+    for (key, present) in keys {
+        if *present {
+            errors.push(SceneError::new(
+                format!("{path}.{key}"),
+                format!("only for pipeline = \"{pipeline}\""),
+            ));
+        }
+    }
+}
+
 pub(super) fn finite_positive(errors: &mut Vec<SceneError>, path: &str, v: f64) {
     check(errors, v.is_finite() && v > 0.0, path, || {
         format!("must be a finite number > 0, got {v}")
@@ -339,20 +351,14 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 "only for pipeline = \"brownian\"",
             ));
         }
+        let fluid_keys = [
+            ("density", g.density.is_some()),
+            ("density_ratios", g.density_ratios.is_some()),
+            ("velocity", g.velocity.is_some()),
+            ("volume_fraction", g.volume_fraction.is_some()),
+        ];
         if is_brownian {
-            for (key, present) in [
-                ("density", g.density.is_some()),
-                ("density_ratios", g.density_ratios.is_some()),
-                ("velocity", g.velocity.is_some()),
-                ("volume_fraction", g.volume_fraction.is_some()),
-            ] {
-                if present {
-                    errors.push(SceneError::new(
-                        format!("{p}.{key}"),
-                        "only for pipeline = \"particle_fluid\"",
-                    ));
-                }
-            }
+            reject_keys(&mut errors, &p, &fluid_keys, "particle_fluid");
         }
         total = total.saturating_add(g.count);
         if is_brownian {
@@ -372,21 +378,12 @@ pub fn parse_and_validate(text: &str, registry: &SceneRegistry) -> Result<Scene,
                 )),
             }
         } else if !is_pf {
-            for (key, present) in [
+            let brownian_keys = [
                 ("moment", g.moment.is_some()),
                 ("placement", g.placement.is_some()),
-                ("density", g.density.is_some()),
-                ("density_ratios", g.density_ratios.is_some()),
-                ("velocity", g.velocity.is_some()),
-                ("volume_fraction", g.volume_fraction.is_some()),
-            ] {
-                if present {
-                    errors.push(SceneError::new(
-                        format!("{p}.{key}"),
-                        "only for pipeline = \"brownian\"",
-                    ));
-                }
-            }
+            ];
+            reject_keys(&mut errors, &p, &brownian_keys, "brownian");
+            reject_keys(&mut errors, &p, &fluid_keys, "particle_fluid");
         }
         match g.shape {
             ShapeSpec::Sphere { radius } => {

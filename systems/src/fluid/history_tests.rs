@@ -1,6 +1,7 @@
 //! Tests of the Basset history kernels (module `history`).
 
 use super::*;
+use std::f64::consts::{E, PI};
 
 /// Composite Gauss–Legendre (5 points) of `f` on `[a, b]` with `panels` panels.
 fn gauss(f: impl Fn(f64) -> f64, a: f64, b: f64, panels: usize) -> f64 {

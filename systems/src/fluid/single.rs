@@ -84,6 +84,37 @@ impl SphereInLiquid {
         }
     }
 
+    /// A sphere of `radius` [m] and `density` [kg/m³] released in quiescent MnCl₂(aq) without
+    /// a magnet, with Stokes drag: the set-up of the exact unsteady-Stokes release
+    /// (`stokes_reference::StokesRelease`) used to validate the history quadrature.
+    ///
+    /// ```
+    /// use magsep_systems::fluid::history::HistoryKernel;
+    /// use magsep_systems::fluid::single::SphereInLiquid;
+    /// let s = SphereInLiquid::stokes_release(50e-6, 1434.0, HistoryKernel::Full);
+    /// assert_eq!(s.diameter, 100e-6);
+    /// ```
+    pub fn stokes_release(radius: f64, density: f64, history: HistoryKernel) -> Self {
+        Self {
+            liquid: Liquid {
+                density: 1403.0,
+                viscosity: 5.54e-3,
+                susceptibility: 0.0,
+            },
+            magnet: MagnetModel::None,
+            gravity: 9.81,
+            diameter: 2.0 * radius,
+            density,
+            terms: ForceTerms {
+                magnetic_buoyancy: false,
+                ..ForceTerms::default()
+            },
+            drag_law: DragLaw::Stokes,
+            integrator: Integrator::Implicit,
+            history,
+        }
+    }
+
     /// Volume [m³].
     pub fn volume(&self) -> f64 {
         std::f64::consts::PI * self.diameter.powi(3) / 6.0

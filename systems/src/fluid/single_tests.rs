@@ -14,22 +14,8 @@ fn stokes_sphere(
     integrator: Integrator,
 ) -> SphereInLiquid {
     SphereInLiquid {
-        liquid: Liquid {
-            density: 1403.0,
-            viscosity: 5.54e-3,
-            susceptibility: 0.0,
-        },
-        magnet: MagnetModel::None,
-        gravity: 9.81,
-        diameter: 2.0 * a,
-        density: rho_p,
-        terms: ForceTerms {
-            magnetic_buoyancy: false,
-            ..ForceTerms::default()
-        },
-        drag_law: DragLaw::Stokes,
         integrator,
-        history,
+        ..SphereInLiquid::stokes_release(a, rho_p, history)
     }
 }
 
