@@ -100,3 +100,61 @@ pub fn magnet_backdrop(cfg: &ParticleFluidConfig, edges: DVec3) -> Vec<BackdropC
     }
     cubes
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use magsep_systems::fluid::config::{ForceTerms, HistoryChoice, Integrator};
+    use magsep_systems::fluid::drag::DragLaw;
+    use magsep_systems::fluid::flow::FlowModel;
+    use magsep_systems::fluid::magnet::Liquid;
+
+    #[test]
+    fn a_levitating_particle_has_the_colour_of_its_slice() {
+        let cfg = ParticleFluidConfig {
+            dt: 1e-3,
+            steps: 1,
+            gravity: 9.81,
+            mid_plane: 0.075,
+            liquid: Liquid {
+                density: 1403.0,
+                viscosity: 5.54e-3,
+                susceptibility: 7e-4,
+            },
+            magnet: MagnetModel::Bottom {
+                surface_field: 422e3,
+                pole_size: 0.1181,
+                half_height: 0.075,
+            },
+            flow: FlowModel::Quiescent,
+            terms: ForceTerms::default(),
+            drag_law: DragLaw::SchillerNaumann,
+            history: HistoryChoice::default(),
+            integrator: Integrator::Implicit,
+            levitation_tolerance: 5e-4,
+            observe_every: 1,
+        };
+        let cubes = magnet_backdrop(&cfg, DVec3::splat(0.15));
+        assert_eq!(cubes.len(), SLICES + 1); // slices and the bottom face
+        // heavy near the magnet (red), the liquid's own density far above (white)
+        assert!(cubes[0].colour[0] > 0.8 && cubes[0].colour[2] < 0.4);
+        assert!(cubes[SLICES - 1].colour.iter().take(3).all(|c| *c > 0.85));
+        let z_e = cfg.equilibrium_height(1434.0).unwrap();
+        let slice = cubes
+            .iter()
+            .take(SLICES)
+            .min_by(|a, b| {
+                (a.center.z - z_e)
+                    .abs()
+                    .total_cmp(&(b.center.z - z_e).abs())
+            })
+            .unwrap();
+        let particle = density_colour(&cfg, 1434.0);
+        for k in 0..3 {
+            assert!(
+                (slice.colour[k] - particle[k]).abs() < 0.05,
+                "{slice:?} {particle:?}"
+            );
+        }
+    }
+}

@@ -500,3 +500,35 @@ fn record_write_sample_for_python_check() {
     w.finish().unwrap();
     eprintln!("wrote {}", path.display());
 }
+
+#[test]
+fn record_scene_draws_the_backdrop() {
+    let frame = ParticleFrame {
+        step: 1,
+        time: 0.0,
+        box_edges: DVec3::splat(1.0),
+        ids: vec![0],
+        positions: vec![DVec3::splat(0.5)],
+        orientations: vec![DQuat::IDENTITY],
+        radii: vec![0.1],
+        half_lengths: vec![0.0],
+        rng_states: vec![[0; 4]],
+        status_json: "{}".into(),
+    };
+    let decor = scene::SceneDecor {
+        backdrop: vec![crate::record::BackdropCube {
+            center: DVec3::new(0.5, 0.5, 0.25),
+            size: DVec3::new(1.0, 1.0, 0.5),
+            colour: [0.9, 0.3, 0.2, 0.1],
+        }],
+        ..Default::default()
+    };
+    let s = scene::scene_update(&frame, None, &decor, 1);
+    let b = s
+        .entities
+        .iter()
+        .find(|e| e.id == scene::BACKDROP_ENTITY)
+        .expect("backdrop entity");
+    assert_eq!(b.cubes.len(), 1);
+    assert_eq!(b.cubes[0].color.unwrap().a, f64::from(0.1f32));
+}
