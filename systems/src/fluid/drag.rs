@@ -38,7 +38,8 @@ pub enum DragLaw {
 /// use magsep_systems::fluid::drag::{translational_drag, DragLaw};
 /// let (f, k, re) = translational_drag(DragLaw::Stokes, 1000.0, 1e-3, 1e-3, DVec3::X * 1e-3);
 /// assert!((k - 3.0 * std::f64::consts::PI * 1e-6).abs() < 1e-18);
-/// assert!((f.x - k * 1e-3).abs() < 1e-20 && (re - 1e-3).abs() < 1e-15);
+/// // Re = ρ d |u − v| / μ = 1000 · 1e-3 · 1e-3 / 1e-3 = 1
+/// assert!((f.x - k * 1e-3).abs() < 1e-20 && (re - 1.0).abs() < 1e-12);
 /// ```
 pub fn translational_drag(
     law: DragLaw,
