@@ -130,9 +130,9 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
-    /// Benchmarks (`magsep bench packing`, `magsep bench field`).
+    /// Benchmarks (`magsep bench packing`, `magsep bench particle-fluid --json`).
     Bench {
-        /// What to benchmark: packing or field.
+        /// What to benchmark: packing, field, brownian or particle-fluid.
         what: String,
         /// One JSON object per measurement on stdout.
         #[arg(long)]
@@ -143,7 +143,8 @@ enum Command {
     },
     /// Charts as SVG (`magsep chart packing --out DIR`).
     Chart {
-        /// Which chart family: packing or field.
+        /// Which chart family: packing, field, brownian, brownian-cost, cylinder, wedge,
+        /// superballs, sq-contact, levitation, history, collisions or separation.
         what: String,
         /// Output directory.
         #[arg(long, default_value = "charts")]
