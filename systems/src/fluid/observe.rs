@@ -69,18 +69,28 @@ impl SeparationCurve {
         }
     }
 
-    /// The first sample time at which e_m falls to `level` and stays there to the end
-    /// (NaN if it never does).
+    /// The time at which e_m falls to `level` for good (it stays at or below `level` to the
+    /// end), interpolated linearly between the two samples that bracket the last crossing; the
+    /// first sample time if e_m starts there, NaN if it never does.
     ///
     /// ```
     /// use magsep_systems::fluid::observe::SeparationCurve;
     /// let c = SeparationCurve { times: vec![0.0, 1.0, 2.0, 3.0], total: vec![1.0, 0.01, 0.05, 0.01], ..Default::default() };
-    /// assert_eq!(c.time_to(0.02), 3.0);
+    /// assert!((c.time_to(0.02) - 2.75).abs() < 1e-12);
+    /// assert!(c.time_to(0.001).is_nan());
     /// ```
     pub fn time_to(&self, level: f64) -> f64 {
         match self.total.iter().rposition(|&e| e.is_nan() || e > level) {
             None => self.times.first().copied().unwrap_or(f64::NAN),
-            Some(k) if k + 1 < self.times.len() => self.times[k + 1],
+            Some(k) if k + 1 < self.times.len() => {
+                let (e0, e1) = (self.total[k], self.total[k + 1]);
+                let (t0, t1) = (self.times[k], self.times[k + 1]);
+                if e0.is_finite() && e0 > e1 {
+                    t0 + (t1 - t0) * (e0 - level) / (e0 - e1)
+                } else {
+                    t1
+                }
+            }
             Some(_) => f64::NAN,
         }
     }
