@@ -1,4 +1,4 @@
-//! Smoke tests of `magsep chart levitation`, `magsep chart history` and `magsep bench
+//! Smoke tests of `magsep chart levitation`, `history`, `separation`, `collisions` and `magsep bench
 //! particle-fluid` in their quick versions: they run, write non-empty SVGs into a fresh
 //! directory, and return Ok. Physics numbers are tested in the kernels' own tests; timings are
 //! never asserted.
@@ -68,4 +68,16 @@ fn quick_history_chart_writes_its_svgs() {
 #[test]
 fn quick_particle_fluid_bench_runs() {
     magsep::fluid_charts::bench_particle_fluid(true, true).unwrap();
+}
+
+/// Release tier (about 40 s): the six reduced many-particle cases and the binary collisions.
+#[test]
+#[ignore = "release tier: cargo test --release -- --ignored"]
+fn quick_separation_and_collision_charts_write_their_svgs() {
+    let dir = temp_dir("separation");
+    magsep::fluid_charts::chart_separation(&dir, true).unwrap();
+    assert_svgs(&dir, &["separation_cases.svg", "separation_groups.svg"]);
+    magsep::fluid_charts::chart_collisions(&dir, true).unwrap();
+    assert_svgs(&dir, &["collisions_trajectories.svg"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }
