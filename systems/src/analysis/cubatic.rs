@@ -222,7 +222,7 @@ pub fn cubatic_order(orientations: &[DQuat]) -> f64 {
 
 /// Finite-size floor of S_4: its mean over `sets` samples of `n` isotropic orientations
 /// (streams of `seed`). Isotropic orientations have S_4 = 0 in expectation, but the maximum over
-/// directions is biased upwards by about `1/√n` (≈ 0.04 at n = 750, ≈ 0.15 at n = 60), so a
+/// directions is biased upwards by about `1/√n` (0.040 at n = 750, 0.13 at n = 60), so a
 /// measured S_4 means order only above this floor.
 ///
 /// ```
