@@ -107,25 +107,19 @@ mod tests {
     use magsep_systems::fluid::config::{ForceTerms, HistoryChoice, Integrator};
     use magsep_systems::fluid::drag::DragLaw;
     use magsep_systems::fluid::flow::FlowModel;
-    use magsep_systems::fluid::magnet::Liquid;
+    use magsep_systems::fluid::single::SphereInLiquid;
 
     #[test]
     fn a_levitating_particle_has_the_colour_of_its_slice() {
+        // the thesis-002 rig of table 2.1 (liquid and bottom magnet)
+        let rig = SphereInLiquid::table_2_1(5e-3);
         let cfg = ParticleFluidConfig {
             dt: 1e-3,
             steps: 1,
-            gravity: 9.81,
+            gravity: rig.gravity,
             mid_plane: 0.075,
-            liquid: Liquid {
-                density: 1403.0,
-                viscosity: 5.54e-3,
-                susceptibility: 7e-4,
-            },
-            magnet: MagnetModel::Bottom {
-                surface_field: 422e3,
-                pole_size: 0.1181,
-                half_height: 0.075,
-            },
+            liquid: rig.liquid,
+            magnet: rig.magnet,
             flow: FlowModel::Quiescent,
             terms: ForceTerms::default(),
             drag_law: DragLaw::SchillerNaumann,
