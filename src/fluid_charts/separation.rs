@@ -126,12 +126,14 @@ pub fn chart_separation(out: &Path, quick: bool) -> Result<(), BenchError> {
         .par_iter()
         .map(|&(k, seed)| {
             let (name, text, _) = CASES[k];
-            let text = reduced(text, quick, name == "2").replacen(
-                "seed = 1\n",
-                &format!("seed = {seed}\n"),
-                1,
-            );
-            run_case(&text)
+            let text = reduced(text, quick, name == "2");
+            // the shipped scenes set `seed = 1`; without it every seed would run the same case
+            if !text.contains("seed = 1\n") {
+                return Err(BenchError::Runtime(format!(
+                    "case {name}: the scene sets no `seed = 1` to vary"
+                )));
+            }
+            run_case(&text.replacen("seed = 1\n", &format!("seed = {seed}\n"), 1))
         })
         .collect::<Result<_, _>>()?;
     // per case: the seed-averaged curve and every seed's run
