@@ -13,28 +13,32 @@
 
 #![warn(missing_docs)]
 
-pub mod bench;
-pub mod bench_brownian;
-pub mod bench_field;
-pub mod brownian;
 pub mod chart;
+pub mod cli;
+pub mod error;
 pub mod fieldtool;
-pub mod fluid_charts;
-pub mod packing_charts;
-pub mod particle_fluid;
+pub mod pipelines;
 pub mod replay;
 pub mod scene;
 pub mod sim;
-pub mod sq_study;
-pub mod summary;
+pub mod studies;
 
+pub use pipelines::{brownian, packing, particle_fluid};
+pub use scene::{Pipeline, Registry};
 pub use sim::{RunOptions, SimError, Simulation};
 
 /// Everything a user usually needs.
 pub mod prelude {
-    pub use crate::sim::{RunOptions, SimError, Simulation};
+    pub use crate::pipelines::brownian::BrownianPipeline;
+    pub use crate::pipelines::packing::PackingPipeline;
+    pub use crate::pipelines::particle_fluid::ParticleFluidPipeline;
+    pub use crate::scene::{ParseContext, Pipeline, Registry, RunInfo, Scene, SceneSection};
+    pub use crate::sim::{RunOptions, SimError, Simulation, SimulationBuilder, SummaryExtras};
     pub use magsep_components::prelude::*;
     pub use magsep_plugins::app::{SimApp, SimPlugin};
+    pub use magsep_plugins::brownian::{
+        BrownianForcesPlugin, BrownianIntegratorPlugin, CaptureObservePlugin, brownian_pipeline,
+    };
     pub use magsep_plugins::core::{CorePlugin, FinalizeSystems};
     pub use magsep_plugins::group::PipelineGroup;
     pub use magsep_plugins::packing::{
@@ -48,7 +52,11 @@ pub mod prelude {
     pub use magsep_systems::sets::{ForceSystems, ObserveSchedule, SimSchedule, SimSystems};
 }
 
-/// The crates underneath, re-exported.
+/// The crates underneath, re-exported (use these paths to get matching versions).
+pub use bevy_ecs;
+pub use glam;
 pub use magsep_components as components;
 pub use magsep_plugins as plugins;
 pub use magsep_systems as systems;
+pub use serde_json;
+pub use toml;

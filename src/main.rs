@@ -1,7 +1,5 @@
 //! The `magsep` command-line tool. Exit codes: 0 ok, 2 bad input, 1 runtime failure.
 
-mod cli;
-
 fn main() {
-    std::process::exit(cli::main());
+    std::process::exit(magsep::cli::main());
 }

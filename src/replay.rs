@@ -1,45 +1,26 @@
-//! Replay: re-run the `Observe` systems on recorded frames.
+//! Replay and resume of recordings, for any registered pipeline: the recorded scene is parsed
+//! with the registry, and its pipeline recomputes the summary ([`Pipeline::replay`]) or
+//! continues the run ([`Pipeline::apply_frame`]). The frame helpers here are shared by the
+//! pipelines.
+//!
+//! [`Pipeline::replay`]: crate::scene::Pipeline::replay
+//! [`Pipeline::apply_frame`]: crate::scene::Pipeline::apply_frame
 
-use std::path::Path;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
-use magsep_plugins::app::SimApp;
-use magsep_plugins::packing::PackingObservePlugin;
-use magsep_plugins::record::{ParticleFrame, RecordError, Recording, read_recording};
+use magsep_plugins::app::SimPlugin;
+use magsep_plugins::record::{ParticleFrame, Recording, read_recording};
 use magsep_plugins::recorder::FrameStatus;
 use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
 
-use crate::scene::{SceneErrors, parse_scene};
-use crate::summary::packing_summary;
-
-/// Why a replay failed.
-#[derive(Debug, thiserror::Error)]
-pub enum ReplayError {
-    /// The recording could not be read.
-    #[error(transparent)]
-    Record(#[from] RecordError),
-    /// The recording has no `magsep` metadata record.
-    #[error(
-        "the recording has no `magsep` metadata record (scene text, seed): not written by magsep run"
-    )]
-    NoMetadata,
-    /// The recorded scene does not parse with this version.
-    #[error("the recorded scene is invalid:\n{0}")]
-    Scene(#[from] SceneErrors),
-    /// The recording holds no frame.
-    #[error("the recording holds no frame{0}")]
-    NoFrames(String),
-    /// A frame is inconsistent.
-    #[error("frame at step {step} is inconsistent: {detail}")]
-    BadFrame {
-        /// Step of the frame.
-        step: u64,
-        /// What is wrong.
-        detail: String,
-    },
-}
+pub use crate::error::ReplayError;
+use crate::scene::{Registry, RunOptions, parse_scene};
+use crate::sim::{SimError, Simulation};
 
 /// Spawn the particles of `frame` into `world` and set the container, clock and status.
 /// `shapes` (in id order, from the recorded scene) override the frame's radii and half
@@ -84,13 +65,15 @@ pub fn load_frame(
         });
     }
     let e = frame.box_edges;
-    if !(e.is_finite() && e.min_element() > 0.0) {
+    let unbounded = e == glam::DVec3::ZERO || e == glam::DVec3::splat(f64::INFINITY);
+    if !unbounded && !(e.is_finite() && e.min_element() > 0.0) {
         return Err(bad(format!("box edges {e}")));
     }
     let status: FrameStatus =
         serde_json::from_str(&frame.status_json).map_err(|e| bad(format!("status_json: {e}")))?;
     let container = match status.container {
         Some(Container::Walled { walls, .. }) => Container::Walled { walls, edges: e },
+        _ if unbounded => Container::Unbounded,
         _ => Container::PeriodicBox { edges: e },
     };
     world.insert_resource(container);
@@ -102,9 +85,6 @@ pub fn load_frame(
             0.0
         },
     });
-    if let Some(s) = status.packing {
-        world.insert_resource(s);
-    }
     Ok(())
 }
 
@@ -132,38 +112,83 @@ pub fn recorded_wall_time(rec: &Recording) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Replay a recording: the summary of its last frame (same keys as `magsep run`), and the
-/// recording itself.
+/// Replay a recording with the built-in pipelines: the summary of its last frame (same keys
+/// as `magsep run`), and the recording itself.
 ///
 /// # Errors
 /// [`ReplayError`].
 pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
+    replay_with(path, &Registry::default())
+}
+
+/// Replay a recording with the pipelines of `registry`.
+///
+/// # Errors
+/// [`ReplayError`].
+pub fn replay_with(path: &Path, registry: &Registry) -> Result<(Value, Recording), ReplayError> {
     let rec = read_recording(path)?;
     let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
-    let scene = parse_scene(&meta.scene_text, &Default::default())?;
-    if scene.brownian_section().is_some() {
-        let summary = crate::brownian::replay::replay_brownian(&rec, &scene, meta.seed)?;
-        return Ok((summary, rec));
-    }
-    if scene.particle_fluid.is_some() {
-        let summary =
-            crate::particle_fluid::replay::replay_particle_fluid(&rec, &scene, meta.seed)?;
-        return Ok((summary, rec));
-    }
-    let frame = last_frame(&rec)?;
-    let mut app = SimApp::new();
-    app.world.insert_resource(scene.packing_config());
-    load_frame(&mut app.world, frame, Some(&scene.shapes()))?;
-    app.add_plugin(&PackingObservePlugin);
-    app.finish().map_err(|e| ReplayError::BadFrame {
-        step: frame.step,
-        detail: e.0,
+    let scene = parse_scene(&meta.scene_text, registry)?;
+    let pipeline = scene.pipeline.clone().ok_or_else(|| {
+        ReplayError::Unsupported("the recorded scene is field-only: nothing to replay".into())
     })?;
-    app.observe_now();
-    let wall = recorded_wall_time(&rec);
-    let mut summary = packing_summary(&app.world, meta.seed, wall);
-    if let Some(t) = &rec.truncated {
-        summary["truncated"] = Value::String(t.clone());
-    }
+    let summary = pipeline.replay(&rec, &scene, meta.seed)?;
     Ok((summary, rec))
+}
+
+/// Systems of the recorded schedule that the schedule `scene` builds here lacks (by name):
+/// a run continued without them would silently differ.
+pub fn missing_systems(
+    recorded: &BTreeMap<String, Vec<String>>,
+    here: &BTreeMap<String, Vec<String>>,
+) -> Vec<String> {
+    let have: BTreeSet<&String> = here.values().flatten().collect();
+    let mut missing: Vec<String> = recorded
+        .values()
+        .flatten()
+        .filter(|s| !have.contains(s))
+        .cloned()
+        .collect();
+    missing.sort();
+    missing.dedup();
+    missing
+}
+
+/// Continue the run recorded in `path` from its last complete frame to the end of the scene,
+/// optionally recording the continuation to `record`; `plugins` are built after the
+/// pipeline's group (a program with user plugins passes the ones it ran with). Refused when the
+/// recorded schedule has systems this program's schedule lacks. Returns the summary of the
+/// whole run.
+///
+/// # Errors
+/// [`ReplayError`].
+pub fn resume(
+    path: &Path,
+    registry: &Registry,
+    record: Option<PathBuf>,
+    plugins: &[Arc<dyn SimPlugin>],
+    on_step: impl FnMut(&World),
+) -> Result<Value, ReplayError> {
+    let rec = read_recording(path)?;
+    let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
+    let scene = parse_scene(&meta.scene_text, registry)?;
+    let frame = last_frame(&rec)?.clone();
+    let options = RunOptions {
+        seed: Some(meta.seed),
+        record,
+        resume_from: Some(frame),
+        plugins: plugins.to_vec(),
+        ..Default::default()
+    };
+    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| match e {
+        SimError::Resume(m) if m.contains("does not record enough state") => {
+            ReplayError::Unsupported(m)
+        }
+        other => ReplayError::Sim(other),
+    })?;
+    let missing = missing_systems(&meta.schedule, &sim.app.resolved_schedule());
+    if !missing.is_empty() {
+        return Err(ReplayError::MissingPlugins(missing.join(", ")));
+    }
+    Ok(sim.run(on_step)?)
 }

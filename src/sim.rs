@@ -1,58 +1,22 @@
-//! The [`Simulation`] builder: scene -> world -> pipeline -> run, with optional recording.
+//! The simulation driver: scene -> world -> the scene's pipeline -> run, with optional
+//! recording. It knows no pipeline by name: every pipeline-specific step is a hook of the
+//! scene's [`Pipeline`](crate::scene::Pipeline).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
-use magsep_plugins::app::SimApp;
-use magsep_plugins::brownian::brownian_pipeline;
+use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
-use magsep_plugins::packing::packing_pipeline;
-use magsep_plugins::particle_fluid::particle_fluid_pipeline;
 use magsep_plugins::record::{FibreShape, RecordError, RecordingMetadata, RecordingWriter};
-use magsep_plugins::recorder::Recorder;
+use magsep_plugins::recorder::{Recorder, record_now};
+use serde_json::Value;
 
-use crate::scene::{RecordEvery, Scene, SpawnError, spawn_scene};
-use crate::summary::packing_summary;
-
-/// Errors while building or running a simulation.
-#[derive(Debug, thiserror::Error)]
-pub enum SimError {
-    /// The scene could not be spawned (e.g. random insertion failed).
-    #[error("spawning the scene failed: {0}")]
-    Spawn(#[from] SpawnError),
-    /// The schedule could not be built (ambiguity, cycle).
-    #[error("building the schedule failed: {0}")]
-    Schedule(String),
-    /// The recording could not be written.
-    #[error("recording failed: {0}")]
-    Record(#[from] RecordError),
-    /// The scene has no `[simulation]` (a field-only scene: use `magsep field`).
-    #[error("the scene has no [simulation] to run (a field-only scene: use `magsep field`)")]
-    NothingToRun,
-    /// The frame to resume from does not fit the scene.
-    #[error("cannot resume: {0}")]
-    Resume(String),
-    /// A numerical failure was reported.
-    #[error("numerical failure: {0}")]
-    Health(String),
-}
-
-/// Options of a run beyond the scene.
-#[derive(Clone, Default)]
-pub struct RunOptions {
-    /// Seed overriding `simulation.seed`.
-    pub seed: Option<u64>,
-    /// Write an MCAP recording here.
-    pub record: Option<PathBuf>,
-    /// Use this pipeline instead of the scene's built-in one (custom plugins).
-    pub pipeline: Option<PipelineGroup>,
-    /// Run the schedule on one thread.
-    pub single_threaded: bool,
-    /// Continue from this recorded frame (brownian pipeline; see `magsep replay --resume`).
-    pub resume_from: Option<magsep_plugins::record::ParticleFrame>,
-}
+pub use crate::error::SimError;
+pub use crate::scene::RunOptions;
+use crate::scene::{NoProgress, Pipeline, Progress, RecordEvery, RunInfo, Scene, spawn_scene};
 
 /// A simulation built from a scene.
 ///
@@ -66,20 +30,87 @@ pub struct RunOptions {
 pub struct Simulation {
     /// World and schedules.
     pub app: SimApp,
-    /// Pipeline name.
-    pub pipeline: String,
+    /// The pipeline that runs the scene.
+    pub pipeline: Arc<dyn Pipeline>,
     /// Seed of the run.
     pub seed: u64,
     started: Instant,
 }
 
+/// Build a [`Simulation`] step by step: extra plugins, a recording, a seed.
+///
+/// ```no_run
+/// use magsep::prelude::*;
+/// let scene = magsep::scene::load_scene("scenes/spheres_500.toml".as_ref(), &Default::default()).unwrap();
+/// let summary = Simulation::builder(&scene)
+///     .seed(3)
+///     .record("out.mcap")
+///     .build()
+///     .unwrap()
+///     .run(|_| {})
+///     .unwrap();
+/// ```
+pub struct SimulationBuilder<'a> {
+    scene: &'a Scene,
+    options: RunOptions,
+}
+
+impl SimulationBuilder<'_> {
+    /// Add `plugin` after the pipeline's own plugins.
+    pub fn add_plugin(mut self, plugin: impl SimPlugin) -> Self {
+        self.options.plugins.push(Arc::new(plugin));
+        self
+    }
+
+    /// Use `group` instead of the pipeline's plugin group.
+    pub fn plugins(mut self, group: PipelineGroup) -> Self {
+        self.options.pipeline = Some(group);
+        self
+    }
+
+    /// Record the run to `path` (MCAP).
+    pub fn record(mut self, path: impl Into<PathBuf>) -> Self {
+        self.options.record = Some(path.into());
+        self
+    }
+
+    /// Override the scene's seed.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.options.seed = Some(seed);
+        self
+    }
+
+    /// Run the schedule on one thread.
+    pub fn single_threaded(mut self, yes: bool) -> Self {
+        self.options.single_threaded = yes;
+        self
+    }
+
+    /// Spawn the scene, build the schedule, open the recording.
+    ///
+    /// # Errors
+    /// As [`Simulation::from_scene`].
+    pub fn build(self) -> Result<Simulation, SimError> {
+        let scene = self.scene;
+        Simulation::from_scene(scene, self.options)
+    }
+}
+
 impl Simulation {
+    /// A builder for `scene`.
+    pub fn builder(scene: &Scene) -> SimulationBuilder<'_> {
+        SimulationBuilder {
+            scene,
+            options: RunOptions::default(),
+        }
+    }
+
     /// Spawn `scene`, build its pipeline and open the recording.
     ///
     /// # Errors
     /// [`SimError`] when spawning, building the schedule or opening the recording fails.
     pub fn from_scene(scene: &Scene, options: RunOptions) -> Result<Self, SimError> {
-        let Some(simulation) = &scene.simulation else {
+        let (Some(simulation), Some(pipeline)) = (&scene.simulation, &scene.pipeline) else {
             return Err(SimError::NothingToRun);
         };
         let seed = options.seed.unwrap_or(simulation.seed);
@@ -90,103 +121,21 @@ impl Simulation {
         }
         spawn_scene(scene, &mut app.world, seed)?;
         if let Some(frame) = &options.resume_from {
-            crate::brownian::replay::apply_frame(&mut app.world, frame)
+            pipeline
+                .apply_frame(&mut app.world, frame)
                 .map_err(|e| SimError::Resume(e.to_string()))?;
         }
-        let brownian = scene.brownian_section().is_some();
-        let pipeline = if brownian {
-            "brownian"
-        } else if scene.particle_fluid.is_some() {
-            "particle_fluid"
-        } else {
-            "packing"
-        };
-        let group = options.pipeline.clone().unwrap_or_else(|| match pipeline {
-            "brownian" => brownian_pipeline(),
-            "particle_fluid" => particle_fluid_pipeline(
-                scene
-                    .particle_fluid
-                    .as_ref()
-                    .is_some_and(|pf| pf.section.terms.collisions),
-            ),
-            _ => packing_pipeline(),
-        });
+        let group = options
+            .pipeline
+            .clone()
+            .unwrap_or_else(|| pipeline.plugins(scene));
         group.build(&mut app);
-        app.finish().map_err(|e| SimError::Schedule(e.0))?;
-        if let Some(cfg) = app
-            .world
-            .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
-            .cloned()
-        {
-            let mut rows: Vec<(ParticleId, f64)> = app
-                .world
-                .query::<(&ParticleId, &InertialBody)>()
-                .iter(&app.world)
-                .map(|(id, b)| (*id, b.density))
-                .collect();
-            rows.sort_by_key(|r| r.0);
-            app.world
-                .insert_resource(magsep_plugins::recorder::ParticleColours(
-                    rows.iter()
-                        .map(|r| crate::particle_fluid::view::density_colour(&cfg, r.1))
-                        .collect(),
-                ));
+        for p in &options.plugins {
+            app.add_boxed_plugin(p.clone());
         }
+        app.finish().map_err(|e| SimError::Schedule(e.0))?;
         if let Some(path) = &options.record {
-            let meta = RecordingMetadata {
-                scene_text: scene.text.clone(),
-                seed,
-                version: env!("CARGO_PKG_VERSION").to_string(),
-                pipeline: pipeline.into(),
-                schedule: app.resolved_schedule(),
-                dt: app.world.resource::<StepClock>().dt,
-            };
-            let mut writer = RecordingWriter::create(path, &meta)?;
-            // the fibres as spawned (stable order by FibreId)
-            let mut fibres: Vec<_> = app
-                .world
-                .query::<(&FibreId, &Fibre)>()
-                .iter(&app.world)
-                .map(|(id, f)| (*id, *f))
-                .collect();
-            fibres.sort_by_key(|(id, _)| *id);
-            writer.set_fibres(
-                fibres
-                    .iter()
-                    .map(|(_, f)| FibreShape {
-                        center: f.center,
-                        axis: f.axis,
-                        radius: f.radius,
-                        half_length: f.half_length,
-                    })
-                    .collect(),
-            );
-            writer.set_walls(app.world.resource::<Container>().walls());
-            if let Some(cfg) = app
-                .world
-                .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
-            {
-                let edges = app.world.resource::<Container>().edges();
-                writer.set_backdrop(crate::particle_fluid::view::magnet_backdrop(cfg, edges));
-            }
-            let mut shapes: Vec<_> = app
-                .world
-                .query::<(&ParticleId, &Shape)>()
-                .iter(&app.world)
-                .map(|(id, s)| (*id, *s))
-                .collect();
-            shapes.sort_by_key(|r| r.0);
-            if shapes.iter().any(|r| r.1.is_superquadric()) {
-                writer.set_semi_axes(
-                    shapes
-                        .iter()
-                        .map(|r| match r.1 {
-                            Shape::Superquadric { semi_axes, .. } => semi_axes,
-                            _ => glam::DVec3::ZERO,
-                        })
-                        .collect(),
-                );
-            }
+            let writer = open_recording(&mut app, path, scene, pipeline.as_ref(), seed)?;
             let every = app
                 .world
                 .get_resource::<RecordEvery>()
@@ -201,7 +150,7 @@ impl Simulation {
         }
         Ok(Self {
             app,
-            pipeline: pipeline.into(),
+            pipeline: pipeline.clone(),
             seed,
             started: Instant::now(),
         })
@@ -214,72 +163,62 @@ impl Simulation {
 
     /// Whether the run has ended.
     pub fn is_finished(&self) -> bool {
-        if let Some(c) = self.app.world.get_resource::<BrownianConfig>() {
-            return self.app.world.resource::<StepClock>().step >= c.steps;
-        }
-        if let Some(c) = self
-            .app
-            .world
-            .get_resource::<magsep_systems::fluid::config::ParticleFluidConfig>()
-        {
-            return self.app.world.resource::<StepClock>().step >= c.steps;
-        }
-        self.app
-            .world
-            .get_resource::<PackingStatus>()
-            .map(|s| s.stopped.is_some())
-            .unwrap_or(true)
+        self.pipeline.is_finished(&self.app.world)
     }
 
-    /// Step until the run ends; `on_step` sees the world after every step. Finishes the
-    /// recording and returns the summary.
+    /// Step until the run ends; `on_step` sees the world after every step. Records the first
+    /// and the final frame, finishes the recording and returns the summary.
     ///
     /// # Errors
     /// A recording write failure or a reported numerical failure.
-    pub fn run(&mut self, mut on_step: impl FnMut(&World)) -> Result<serde_json::Value, SimError> {
+    pub fn run(&mut self, mut on_step: impl FnMut(&World)) -> Result<Value, SimError> {
         self.started = Instant::now();
+        record_now(&mut self.app.world);
         while !self.is_finished() {
             self.step();
             on_step(&self.app.world);
-            if let Some(h) = self.app.world.get_resource::<Health>()
-                && h.is_failed()
-            {
-                return Err(SimError::Health(h.messages.join("; ")));
+            let failed = self
+                .app
+                .world
+                .get_resource::<Health>()
+                .filter(|h| h.is_failed())
+                .map(|h| h.messages.join("; "));
+            if let Some(why) = failed {
+                record_now(&mut self.app.world);
+                return Err(SimError::Health(why));
             }
         }
+        record_now(&mut self.app.world);
         let summary = self.summary();
         self.finish_recording(&summary)?;
         Ok(summary)
     }
 
-    /// The JSON summary of the current state.
-    pub fn summary(&self) -> serde_json::Value {
-        if self.pipeline == "particle_fluid" {
-            return crate::particle_fluid::run_summary(
-                &self.app.world,
-                self.seed,
-                self.started.elapsed().as_secs_f64(),
-            );
+    /// The JSON summary of the current state (the pipeline's, plus the keys plugins added
+    /// to [`SummaryExtras`]).
+    pub fn summary(&self) -> Value {
+        let run = RunInfo {
+            seed: self.seed,
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+        };
+        let mut summary = self.pipeline.summary(&self.app.world, &run);
+        if let (Some(extra), Value::Object(map)) =
+            (self.app.world.get_resource::<SummaryExtras>(), &mut summary)
+        {
+            for (k, f) in &extra.0 {
+                if let Some(v) = f(&self.app.world) {
+                    map.insert(k.clone(), v);
+                }
+            }
         }
-        if self.pipeline == "brownian" {
-            return crate::brownian::run_summary(
-                &self.app.world,
-                self.seed,
-                self.started.elapsed().as_secs_f64(),
-            );
-        }
-        packing_summary(
-            &self.app.world,
-            self.seed,
-            self.started.elapsed().as_secs_f64(),
-        )
+        summary
     }
 
     /// Write the summary into the recording and close it.
     ///
     /// # Errors
     /// A recording write failure.
-    pub fn finish_recording(&mut self, summary: &serde_json::Value) -> Result<(), SimError> {
+    pub fn finish_recording(&mut self, summary: &Value) -> Result<(), SimError> {
         if let Some(mut rec) = self.app.world.remove_resource::<Recorder>() {
             if let Some(e) = rec.error.take() {
                 return Err(SimError::Record(RecordError::InvalidInput { detail: e }));
@@ -293,12 +232,105 @@ impl Simulation {
     }
 }
 
+/// Keys plugins add to the run's summary: (key, function of the final world) (a resource).
+#[derive(Resource, Default, Clone)]
+pub struct SummaryExtras(pub Vec<(String, fn(&World) -> Option<Value>)>);
+
+/// Open the recording of `app` at `path`: metadata (scene, seed, schedule, plugins), fibres,
+/// walls, shapes, and what the pipeline adds.
+fn open_recording(
+    app: &mut SimApp,
+    path: &Path,
+    scene: &Scene,
+    pipeline: &dyn Pipeline,
+    seed: u64,
+) -> Result<RecordingWriter, SimError> {
+    let meta = RecordingMetadata {
+        scene_text: scene.text.clone(),
+        seed,
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        pipeline: pipeline.name().into(),
+        schedule: app.resolved_schedule(),
+        dt: app.world.resource::<StepClock>().dt,
+    };
+    let mut writer = RecordingWriter::create(path, &meta)?;
+    let mut fibres: Vec<_> = app
+        .world
+        .query::<(&FibreId, &Fibre)>()
+        .iter(&app.world)
+        .map(|(id, f)| (*id, *f))
+        .collect();
+    fibres.sort_by_key(|(id, _)| *id);
+    writer.set_fibres(
+        fibres
+            .iter()
+            .map(|(_, f)| FibreShape {
+                center: f.center,
+                axis: f.axis,
+                radius: f.radius,
+                half_length: f.half_length,
+            })
+            .collect(),
+    );
+    if let Some(c) = app.world.get_resource::<Container>() {
+        writer.set_walls(c.walls());
+    }
+    let mut shapes: Vec<_> = app
+        .world
+        .query::<(&ParticleId, &Shape)>()
+        .iter(&app.world)
+        .map(|(id, s)| (*id, *s))
+        .collect();
+    shapes.sort_by_key(|r| r.0);
+    if shapes.iter().any(|r| r.1.is_superquadric()) {
+        writer.set_semi_axes(
+            shapes
+                .iter()
+                .map(|r| match r.1 {
+                    Shape::Superquadric { semi_axes, .. } => semi_axes,
+                    _ => glam::DVec3::ZERO,
+                })
+                .collect(),
+        );
+    }
+    pipeline.prepare_recording(&mut app.world, &mut writer);
+    Ok(writer)
+}
+
+/// Run `scene` to the end the pipeline's way (one simulation, or e.g. replicates), reporting
+/// to `progress`; returns the summary.
+///
+/// # Errors
+/// [`SimError`] of the run.
+pub fn run_scene(
+    scene: &Scene,
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<Value, SimError> {
+    let pipeline = scene.pipeline.clone().ok_or(SimError::NothingToRun)?;
+    if let Some(result) = pipeline.run(scene, options, progress) {
+        return result;
+    }
+    if let Some(n) = pipeline.total_steps(scene) {
+        progress.set_total(n);
+    }
+    let mut sim = Simulation::from_scene(scene, options.clone())?;
+    let mut last = 0u64;
+    sim.run(|w| {
+        let step = w.get_resource::<StepClock>().map(|c| c.step).unwrap_or(0);
+        progress.advance(step.saturating_sub(last));
+        last = step;
+        if let Some(m) = pipeline.progress(w) {
+            progress.message(m);
+        }
+    })
+}
+
 /// Load, spawn and run a scene file to the end (convenience for tests and examples).
 ///
 /// # Errors
 /// Scene errors (as text) or run errors.
-pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<serde_json::Value, String> {
+pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<Value, String> {
     let scene = crate::scene::load_scene(path, &Default::default()).map_err(|e| e.to_string())?;
-    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| e.to_string())?;
-    sim.run(|_| {}).map_err(|e| e.to_string())
+    run_scene(&scene, &options, &NoProgress).map_err(|e| e.to_string())
 }

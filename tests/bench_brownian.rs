@@ -2,7 +2,7 @@
 //! the library API (rows well formed, rates positive, exponents finite; the chart writes a
 //! valid SVG and its JSON data).
 
-use magsep::bench_brownian::{
+use magsep::studies::bench_brownian::{
     BrownianBenchSizes, CostChartSizes, bench_brownian_with, chart_brownian_cost_with,
 };
 use magsep::systems::brownian::hydro::MobilityMethod;
@@ -107,7 +107,7 @@ fn cost_chart_writes_svg_and_data() {
 #[test]
 fn chart_brownian_quick_writes_every_figure() {
     let dir = std::env::temp_dir().join(format!("magsep-chart-brownian-{}", std::process::id()));
-    magsep::brownian::chart::chart_brownian(&dir, true).unwrap();
+    magsep::studies::brownian_chart::chart_brownian(&dir, true).unwrap();
     for name in [
         "brownian_angle_curves.svg",
         "brownian_final_vs_angle.svg",

@@ -93,7 +93,10 @@ fn points(ps: &[DVec3]) -> String {
 }
 
 fn run(scene: &Scene) -> Value {
-    let runs = scene.brownian.as_ref().map(|b| b.runs()).unwrap_or(1);
+    let runs = scene
+        .section::<magsep::brownian::BrownianSection>()
+        .map(|b| b.runs())
+        .unwrap_or(1);
     run_ensemble(scene, runs, &RunOptions::default(), &|_| {}).expect("run")
 }
 

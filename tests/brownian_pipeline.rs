@@ -214,9 +214,13 @@ fn shipped_brownian_scenes_run() {
         let mut s = magsep::scene::load_scene(&path, &Default::default())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         // a few steps of one replicate (the scenes' own durations are long)
-        let b = s.brownian.as_mut().unwrap();
+        let mut b = s
+            .section::<magsep::brownian::BrownianSection>()
+            .unwrap()
+            .clone();
         b.duration = 3.0 * b.time_step;
         b.runs = Some(1);
+        s.set_section(b);
         for g in &mut s.particles {
             g.count = g.count.min(20);
         }

@@ -1,9 +1,9 @@
 //! Recordings of brownian runs: captured particles coloured in the scene channel, replay
 //! recomputes the capture curve, resume from a cut recording continues bitwise.
 
-use magsep::brownian::replay::resume;
 use magsep::plugins::record::read_recording;
 use magsep::prelude::*;
+use magsep::replay::resume;
 use magsep::scene::parse_scene;
 
 const SCENE: &str = r#"
@@ -89,7 +89,14 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
         rec.frames.len()
     );
     let resumed_path = dir.join("resumed.mcap");
-    let resumed = resume(&cut, Some(resumed_path.clone()), |_| {}).unwrap();
+    let resumed = resume(
+        &cut,
+        &Default::default(),
+        Some(resumed_path.clone()),
+        &[],
+        |_| {},
+    )
+    .unwrap();
     for key in [
         "capture_curve",
         "captured_fraction",

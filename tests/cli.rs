@@ -171,7 +171,7 @@ fn record_info_replay_truncation_and_determinism() {
     let replay = magsep(&["replay", rec1.to_str().unwrap()]);
     assert!(replay.status.success(), "{}", stderr(&replay));
     let sr = json(&replay);
-    for key in magsep::summary::PACKING_SUMMARY_KEYS {
+    for key in magsep::packing::PACKING_SUMMARY_KEYS {
         assert_eq!(sr[*key], s1[*key], "replay differs in {key}");
     }
     assert_eq!(sr["wall_time_s"], s1["wall_time_s"]);

@@ -30,7 +30,7 @@ fn assert_svgs(dir: &Path, names: &[&str]) {
 #[test]
 fn quick_levitation_chart_writes_its_svgs() {
     let dir = temp_dir("levitation");
-    magsep::fluid_charts::chart_levitation(&dir, true).unwrap();
+    magsep::studies::fluid_charts::chart_levitation(&dir, true).unwrap();
     assert_svgs(
         &dir,
         &[
@@ -47,7 +47,7 @@ fn quick_levitation_chart_writes_its_svgs() {
 #[test]
 fn quick_history_chart_writes_its_svgs() {
     let dir = temp_dir("history");
-    magsep::fluid_charts::chart_history(&dir, true).unwrap();
+    magsep::studies::fluid_charts::chart_history(&dir, true).unwrap();
     assert_svgs(
         &dir,
         &[
@@ -67,7 +67,7 @@ fn quick_history_chart_writes_its_svgs() {
 
 #[test]
 fn quick_particle_fluid_bench_runs() {
-    magsep::fluid_charts::bench_particle_fluid(true, true).unwrap();
+    magsep::studies::fluid_charts::bench_particle_fluid(true, true).unwrap();
 }
 
 /// Release tier (about 40 s): the six reduced many-particle cases and the binary collisions.
@@ -75,9 +75,9 @@ fn quick_particle_fluid_bench_runs() {
 #[ignore = "release tier: cargo test --release -- --ignored"]
 fn quick_separation_and_collision_charts_write_their_svgs() {
     let dir = temp_dir("separation");
-    magsep::fluid_charts::chart_separation(&dir, true).unwrap();
+    magsep::studies::fluid_charts::chart_separation(&dir, true).unwrap();
     assert_svgs(&dir, &["separation_cases.svg", "separation_groups.svg"]);
-    magsep::fluid_charts::chart_collisions(&dir, true).unwrap();
+    magsep::studies::fluid_charts::chart_collisions(&dir, true).unwrap();
     assert_svgs(&dir, &["collisions_trajectories.svg"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,7 +3,7 @@
 //! Default tier: fast versions (small N). `#[ignore]` tier, run in release by CI with
 //! `cargo test --release -- --ignored`: the thesis's sizes.
 
-use magsep::bench::{PackingRun, packing_run};
+use magsep::studies::bench::{PackingRun, packing_run};
 use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, StopReason, VolumeStepRule};
 use magsep_components::shape::Shape;
 use magsep_systems::packing::compress::{DriverParams, compression_step, initial_status};

@@ -262,15 +262,15 @@ placement = {{ kind = "box", min = [20.0, 20.0, 20.0], max = [21.0, 21.0, 21.0] 
 #[test]
 #[ignore = "validation tier: run with --release -- --ignored"]
 fn cylinder_confinement_reproduces_the_thesis_trends() {
-    use magsep::packing_charts::{measure, rod};
-    use magsep::scene::ContainerSpec;
-    let fire = magsep::packing_charts::Scheme::Fire;
+    use magsep::packing::ContainerSpec;
+    use magsep::studies::packing_charts::{measure, rod};
+    let fire = magsep::studies::packing_charts::Scheme::Fire;
     let run = |l: f64, d: Option<f64>| {
         let spec = match d {
             Some(d) => ContainerSpec::Cylinder { radius: 0.5 * d },
             None => ContainerSpec::PeriodicBox {},
         };
-        let n = magsep::packing_charts::particles_for(&spec, rod(l), 80);
+        let n = magsep::studies::packing_charts::particles_for(&spec, rod(l), 80);
         measure(n, rod(l), &spec, 0.05, 1, fire).unwrap()
     };
     // spheres: a minimum of phi near D_cyl = 2 D, phi* -> 1 for wide columns, single file <C> = 2

@@ -224,7 +224,11 @@ fn shipped_particle_fluid_scenes_run() {
         if !text.contains("pipeline = \"particle_fluid\"") {
             continue;
         }
-        let dt = scene(&text).particle_fluid.unwrap().section.time_step;
+        let dt = scene(&text)
+            .section::<magsep::particle_fluid::ParticleFluidScene>()
+            .unwrap()
+            .section
+            .time_step;
         let short = with_duration(&text, 2.0 * dt);
         let (_, summary) = run(&short, RunOptions::default());
         assert_eq!(summary["steps"], 2, "{}", path.display());

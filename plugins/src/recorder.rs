@@ -1,18 +1,23 @@
-//! Recording plugin: writes a frame to the MCAP recording every `every` steps and at the end
-//! of a run (set `SimSystems::Record`).
+//! Recording plugin: writes a frame to the MCAP recording every `every` steps (set
+//! `SimSystems::Record`); the simulation driver also records step 0 and the final step with
+//! [`record_now`]. The recorder knows no pipeline: a pipeline (or any plugin) adds what its
+//! frames need beyond particles through [`FrameStatusProviders`] (keys of the frame's
+//! `status_json`), [`ParticleColours`] or [`ColourProvider`], and writes channels of its own
+//! through [`Recorder::writer`].
 //!
 //! | set | system | touches |
 //! |---|---|---|
-//! | `Record` | [`record_frame`] | `Recorder`; reads particles, `StepClock`, `Container`, `PackingStatus`, `McmWorkspace`, `BrownianConfig`, `BrownianStats` |
-//!
-//! Brownian runs colour captured particles [`CAPTURED_COLOUR`] and free ones [`FREE_COLOUR`].
+//! | `Record` | [`record_frame`] (exclusive) | `Recorder`; reads particles, `StepClock`, `Container`, the providers |
+
+use std::collections::BTreeMap;
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
-use magsep_systems::packing::systems::McmWorkspace;
 use magsep_systems::rng::rng_state_words;
 use magsep_systems::sets::SimSystems;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
 
 use crate::app::{SimApp, SimPlugin};
 use crate::record::{ParticleFrame, RecordingWriter};
@@ -20,7 +25,8 @@ use crate::record::{ParticleFrame, RecordingWriter};
 /// The open recording (a resource). Without a writer, nothing is recorded.
 #[derive(Resource, Default)]
 pub struct Recorder {
-    /// The writer, if recording.
+    /// The writer, if recording. Plugins may add channels to it and write their messages
+    /// (see `RecordingWriter::add_channel`).
     pub writer: Option<RecordingWriter>,
     /// Record every this many steps (>= 1).
     pub every: u64,
@@ -30,42 +36,57 @@ pub struct Recorder {
     pub last_step: Option<u64>,
 }
 
-/// Pipeline status stored in every frame's `status_json` (for replay and resume).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-pub struct FrameStatus {
-    /// Packing driver status.
-    pub packing: Option<PackingStatus>,
-    /// Packing driver random stream (xoshiro256++ words).
-    pub driver_rng: Option<[u64; 4]>,
-    /// The container (walls and box) of the frame.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub container: Option<Container>,
-    /// Brownian pipeline state beyond positions and random streams.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub brownian: Option<BrownianFrameStatus>,
+/// A function giving one key of a frame's status (`None`: leave the key out).
+pub type StatusFn = fn(&World) -> Option<Value>;
+
+/// The keys of every frame's `status_json` beyond `container`, each with the function that
+/// computes it (a resource; a pipeline registers what it needs to replay or resume a frame).
+#[derive(Resource, Default, Clone)]
+pub struct FrameStatusProviders(pub Vec<(String, StatusFn)>);
+
+impl FrameStatusProviders {
+    /// Add (or replace) the provider of `key`.
+    pub fn set(&mut self, key: impl Into<String>, f: StatusFn) {
+        let key = key.into();
+        self.0.retain(|(k, _)| *k != key);
+        self.0.push((key, f));
+    }
 }
 
-/// Brownian state of a frame (with the positions and streams of the frame: a lossless
-/// checkpoint for `--resume`). Arrays in `ParticleId` order.
+/// A frame's `status_json`: the container (walls and box) and the keys the pipeline's
+/// providers wrote.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-pub struct BrownianFrameStatus {
-    /// Capture of each particle (step and fibre), `null` while free.
-    pub captured: Vec<Option<CaptureEvent>>,
-    /// Start positions [m] (for displacements and the Brownian criterion).
-    pub initial_positions: Vec<[f64; 3]>,
-    /// Stepper counters so far.
-    pub stats: BrownianStats,
+pub struct FrameStatus {
+    /// The container of the frame (walled containers only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub container: Option<Container>,
+    /// The pipeline's keys.
+    #[serde(flatten)]
+    pub keys: BTreeMap<String, Value>,
+}
+
+impl FrameStatus {
+    /// Key `key` typed as `T`: `None` if absent or null.
+    ///
+    /// # Errors
+    /// The serde error when the key does not have the shape of `T`.
+    pub fn get<T: DeserializeOwned>(&self, key: &str) -> Result<Option<T>, serde_json::Error> {
+        match self.keys.get(key) {
+            None | Some(Value::Null) => Ok(None),
+            Some(v) => serde_json::from_value(v.clone()).map(Some),
+        }
+    }
 }
 
 /// Per-particle viewer colours in `ParticleId` order (a resource; e.g. the particle-fluid
-/// pipeline colours by density). Brownian runs colour by capture instead.
+/// pipeline colours by density).
 #[derive(Resource, Debug, Clone, Default)]
 pub struct ParticleColours(pub Vec<[f32; 4]>);
 
-/// Colour of a free particle in the viewer (RGBA).
-pub const FREE_COLOUR: [f32; 4] = [0.35, 0.55, 0.85, 1.0];
-/// Colour of a captured particle in the viewer (RGBA).
-pub const CAPTURED_COLOUR: [f32; 4] = [0.9, 0.25, 0.15, 1.0];
+/// Colours computed per frame (a resource; e.g. the brownian pipeline colours captured
+/// particles): the function gets the world and the frame's particle ids in order.
+#[derive(Resource, Clone, Copy)]
+pub struct ColourProvider(pub fn(&World, &[u64]) -> Vec<[f32; 4]>);
 
 /// Writes frames.
 #[derive(Debug, Clone, Copy, Default)]
@@ -79,121 +100,77 @@ impl SimPlugin for RecordPlugin {
                 ..Default::default()
             });
         }
+        app.world.init_resource::<FrameStatusProviders>();
         app.schedule
             .add_systems(record_frame.in_set(SimSystems::Record));
     }
 }
 
-type FrameQuery<'w, 's> = Query<
-    'w,
-    's,
-    (
-        &'static ParticleId,
-        &'static Position,
-        &'static Orientation,
-        &'static Shape,
-        &'static ParticleRng,
-        Option<&'static Captured>,
-        Option<&'static InitialPosition>,
-    ),
->;
-
 /// Gather the lossless frame of the current state (particles in `ParticleId` order).
-pub fn gather_frame(
-    clock: &StepClock,
-    container: &Container,
-    status: Option<&PackingStatus>,
-    ws: Option<&McmWorkspace>,
-    brownian: Option<&BrownianStats>,
-    q: &FrameQuery,
-) -> ParticleFrame {
-    let mut rows: Vec<_> = q.iter().collect();
+pub fn gather_frame(world: &mut World) -> ParticleFrame {
+    let mut q = world.query::<(
+        &ParticleId,
+        &Position,
+        &Orientation,
+        &Shape,
+        Option<&ParticleRng>,
+    )>();
+    let mut rows: Vec<_> = q.iter(world).collect();
     rows.sort_by_key(|r| *r.0);
-    let fs = FrameStatus {
-        packing: status.copied(),
-        driver_rng: ws.map(|w| rng_state_words(&w.rng)),
-        container: container.walls().map(|_| *container),
-        brownian: brownian.map(|stats| BrownianFrameStatus {
-            captured: rows.iter().map(|r| r.5.and_then(|c| c.0)).collect(),
-            initial_positions: rows
-                .iter()
-                .map(|r| r.6.map(|p| p.0.to_array()).unwrap_or_default())
-                .collect(),
-            stats: stats.clone(),
-        }),
+    let container = world.get_resource::<Container>().copied();
+    let mut fs = FrameStatus {
+        container: container.filter(|c| c.walls().is_some()),
+        keys: BTreeMap::new(),
     };
+    if let Some(p) = world.get_resource::<FrameStatusProviders>() {
+        for (key, f) in &p.0 {
+            fs.keys.insert(key.clone(), f(world).unwrap_or(Value::Null));
+        }
+    }
+    let clock = world
+        .get_resource::<StepClock>()
+        .copied()
+        .unwrap_or_default();
     ParticleFrame {
         step: clock.step,
         time: clock.time(),
-        box_edges: container.edges(),
+        box_edges: container
+            .map(|c| c.edges())
+            .unwrap_or(glam::DVec3::splat(f64::INFINITY)),
         ids: rows.iter().map(|r| r.0.0).collect(),
         positions: rows.iter().map(|r| r.1.0).collect(),
         orientations: rows.iter().map(|r| r.2.0).collect(),
         radii: rows.iter().map(|r| r.3.radius()).collect(),
         half_lengths: rows.iter().map(|r| r.3.half_length()).collect(),
-        rng_states: rows.iter().map(|r| rng_state_words(&r.4.0)).collect(),
+        rng_states: rows
+            .iter()
+            .map(|r| r.4.map(|g| rng_state_words(&g.0)).unwrap_or([0; 4]))
+            .collect(),
         status_json: serde_json::to_string(&fs).unwrap_or_else(|_| "{}".into()),
     }
 }
 
-/// What the recorder reads of the brownian and particle-fluid pipelines, if present.
-type PipelineViews<'w> = (
-    Option<Res<'w, BrownianConfig>>,
-    Option<Res<'w, BrownianStats>>,
-    Option<Res<'w, ParticleColours>>,
-);
-
-/// Record: write a frame every `every` steps and when the run has stopped.
-pub fn record_frame(
-    mut rec: ResMut<Recorder>,
-    clock: Res<StepClock>,
-    container: Res<Container>,
-    status: Option<Res<PackingStatus>>,
-    ws: Option<Res<McmWorkspace>>,
-    (brownian, stats, fixed_colours): PipelineViews,
-    q: FrameQuery,
-) {
-    if rec.writer.is_none() || rec.last_step == Some(clock.step) {
+/// Write a frame of the current state now, unless this step was written already (the
+/// driver calls it for step 0 and for the final step).
+pub fn record_now(world: &mut World) {
+    let step = world.get_resource::<StepClock>().map(|c| c.step);
+    let Some(rec) = world.get_resource::<Recorder>() else {
+        return;
+    };
+    if rec.writer.is_none() || rec.last_step == step {
         return;
     }
-    let stopped = status
-        .as_ref()
-        .map(|s| s.stopped.is_some())
-        .unwrap_or(false)
-        || brownian.as_ref().is_some_and(|c| clock.step >= c.steps);
-    if !(stopped || clock.step.is_multiple_of(rec.every.max(1))) {
-        return;
-    }
-    let stats = brownian
-        .as_ref()
-        .map(|_| stats.as_deref().cloned().unwrap_or_default());
-    let frame = gather_frame(
-        &clock,
-        &container,
-        status.as_deref(),
-        ws.as_deref(),
-        stats.as_ref(),
-        &q,
-    );
-    let fixed = fixed_colours
-        .as_ref()
-        .filter(|c| c.0.len() == frame.ids.len())
-        .map(|c| c.0.clone());
-    let colours: Option<Vec<[f32; 4]>> = fixed.or_else(|| {
-        brownian.as_ref().map(|_| {
-            let mut rows: Vec<_> = q.iter().map(|r| (*r.0, r.5.and_then(|c| c.0))).collect();
-            rows.sort_by_key(|r| r.0);
-            rows.iter()
-                .map(|r| {
-                    if r.1.is_some() {
-                        CAPTURED_COLOUR
-                    } else {
-                        FREE_COLOUR
-                    }
-                })
-                .collect()
-        })
-    });
+    let frame = gather_frame(world);
+    let colours: Option<Vec<[f32; 4]>> = world
+        .get_resource::<ColourProvider>()
+        .map(|p| (p.0)(world, &frame.ids))
+        .or_else(|| {
+            world
+                .get_resource::<ParticleColours>()
+                .filter(|c| c.0.len() == frame.ids.len())
+                .map(|c| c.0.clone())
+        });
+    let mut rec = world.resource_mut::<Recorder>();
     let result = rec
         .writer
         .as_mut()
@@ -203,6 +180,17 @@ pub fn record_frame(
             rec.error = Some(e.to_string());
             rec.writer = None;
         }
-        _ => rec.last_step = Some(clock.step),
+        _ => rec.last_step = Some(frame.step),
+    }
+}
+
+/// Record: write a frame every `every` steps.
+pub fn record_frame(world: &mut World) {
+    let step = world.get_resource::<StepClock>().map(|c| c.step);
+    let due = world.get_resource::<Recorder>().is_some_and(|r| {
+        r.writer.is_some() && step.is_some_and(|s| s.is_multiple_of(r.every.max(1)))
+    });
+    if due {
+        record_now(world);
     }
 }

@@ -4,12 +4,12 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use magsep::chart::{ColourScale, Heatmap};
-use magsep::fieldtool::{
+use crate::chart::{ColourScale, Heatmap};
+use crate::fieldtool::{
     FieldScene, MapQuantity, csv_header, field_map, field_rows, parse_extent, parse_slice,
     read_points,
 };
-use magsep::scene::load_scene;
+use crate::scene::load_scene;
 use magsep_systems::field::MomentModel;
 
 use super::CliError;

@@ -2,11 +2,11 @@
 
 use std::path::Path;
 
-use magsep::plugins::record::{RecordError, read_recording};
-use magsep::replay::{ReplayError, replay as replay_recording};
+use crate::plugins::record::{RecordError, read_recording};
+use crate::replay::{ReplayError, replay_with};
 use serde_json::json;
 
-use super::CliError;
+use super::{CliError, Extensions};
 
 fn record_error(path: &Path, e: RecordError) -> CliError {
     match e {
@@ -108,11 +108,8 @@ pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
     Ok(())
 }
 
-pub fn replay(path: &Path) -> Result<(), CliError> {
-    let (summary, _) = replay_recording(path).map_err(|e| match e {
-        ReplayError::Record(r) => record_error(path, r),
-        other => CliError::input(format!("{}: {other}", path.display())),
-    })?;
+pub fn replay(ext: &Extensions, path: &Path) -> Result<(), CliError> {
+    let (summary, _) = replay_with(path, &ext.registry).map_err(|e| replay_error(path, e))?;
     println!(
         "{}",
         serde_json::to_string_pretty(&summary).unwrap_or_default()
@@ -120,7 +117,16 @@ pub fn replay(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
+fn replay_error(path: &Path, e: ReplayError) -> CliError {
+    match e {
+        ReplayError::Record(r) => record_error(path, r),
+        ReplayError::Sim(e) => CliError::runtime(e.to_string()),
+        other => CliError::input(format!("{}: {other}", path.display())),
+    }
+}
+
 pub fn resume(
+    ext: &Extensions,
     path: &Path,
     record: Option<std::path::PathBuf>,
     quiet: bool,
@@ -130,23 +136,15 @@ pub fn resume(
     } else {
         indicatif::ProgressBar::new_spinner()
     };
-    let summary = magsep::brownian::replay::resume(path, record, |w| {
-        if let Some(c) = w.get_resource::<magsep::components::clock::StepClock>()
+    let summary = crate::replay::resume(path, &ext.registry, record, &ext.plugins, |w| {
+        if let Some(c) = w.get_resource::<crate::components::clock::StepClock>()
             && c.step % 1000 == 0
         {
             bar.set_message(format!("step {}", c.step));
             bar.tick();
         }
     })
-    .map_err(|e| match e {
-        magsep::brownian::replay::ResumeError::Replay(ReplayError::Record(r)) => {
-            record_error(path, r)
-        }
-        magsep::brownian::replay::ResumeError::Replay(other) => {
-            CliError::input(format!("{}: {other}", path.display()))
-        }
-        magsep::brownian::replay::ResumeError::Sim(e) => CliError::runtime(e.to_string()),
-    })?;
+    .map_err(|e| replay_error(path, e))?;
     bar.finish_and_clear();
     println!(
         "{}",

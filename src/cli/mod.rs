@@ -1,7 +1,23 @@
-//! CLI commands (clap). Each command returns `Result<(), CliError>`; the error's code is the
-//! process exit code.
+//! The `magsep` command line (clap), also for a user's own binary: [`main_with`] gives it
+//! `run`, `validate`, `info`, `replay` (and the rest) with its own pipelines and plugins.
+//! Each command returns `Result<(), CliError>`; the error's code is the process exit code
+//! (0 ok, 2 bad input, 1 runtime failure).
+//!
+//! ```no_run
+//! use magsep::cli::{Extensions, main_with};
+//! use magsep::prelude::*;
+//! // a binary with the built-in pipelines plus one of its own:
+//! // let ext = Extensions::default().pipeline(MyPipeline);
+//! let ext = Extensions::default();
+//! std::process::exit(main_with(ext));
+//! ```
 
 use std::path::PathBuf;
+use std::sync::Arc;
+
+use magsep_plugins::app::SimPlugin;
+
+use crate::scene::{Pipeline, Registry};
 
 use clap::{Parser, Subcommand};
 
@@ -155,8 +171,38 @@ enum Command {
     },
 }
 
-/// Parse arguments, run, print errors; returns the exit code.
+/// What a program adds to the built-in CLI: pipelines, scene kinds, and plugins built into
+/// every run (and expected by `replay --resume`).
+#[derive(Clone, Default)]
+pub struct Extensions {
+    /// The pipelines and scene kinds (default: the built-in pipelines).
+    pub registry: Registry,
+    /// Plugins added after the pipeline's group in every run.
+    pub plugins: Vec<Arc<dyn SimPlugin>>,
+}
+
+impl Extensions {
+    /// Register `pipeline` too.
+    pub fn pipeline(mut self, pipeline: impl Pipeline) -> Self {
+        self.registry = self.registry.with_pipeline(pipeline);
+        self
+    }
+
+    /// Build `plugin` into every run.
+    pub fn plugin(mut self, plugin: impl SimPlugin) -> Self {
+        self.plugins.push(Arc::new(plugin));
+        self
+    }
+}
+
+/// The `magsep` CLI with the built-in pipelines; returns the exit code.
 pub fn main() -> i32 {
+    main_with(Extensions::default())
+}
+
+/// The CLI with `ext`'s pipelines and plugins; parses the process arguments, runs, prints
+/// errors, and returns the exit code.
+pub fn main_with(ext: Extensions) -> i32 {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -172,8 +218,8 @@ pub fn main() -> i32 {
             seed,
             quiet,
             threads,
-        } => run::run(&scene, record, seed, quiet, threads),
-        Command::Validate { scene } => run::validate(&scene),
+        } => run::run(&ext, &scene, record, seed, quiet, threads),
+        Command::Validate { scene } => run::validate(&ext, &scene),
         Command::Field {
             scene,
             points,
@@ -206,16 +252,16 @@ pub fn main() -> i32 {
             quiet,
         } => {
             if resume {
-                info::resume(&recording, record, quiet)
+                info::resume(&ext, &recording, record, quiet)
             } else {
-                info::replay(&recording)
+                info::replay(&ext, &recording)
             }
         }
         Command::Bench { what, json, quick } => {
-            magsep::bench::bench(&what, json, quick).map_err(to_cli)
+            crate::studies::bench::bench(&what, json, quick).map_err(to_cli)
         }
         Command::Chart { what, out, quick } => {
-            magsep::bench::chart(&what, &out, quick).map_err(to_cli)
+            crate::studies::bench::chart(&what, &out, quick).map_err(to_cli)
         }
     };
     match result {
@@ -227,9 +273,9 @@ pub fn main() -> i32 {
     }
 }
 
-fn to_cli(e: magsep::bench::BenchError) -> CliError {
+fn to_cli(e: crate::studies::bench::BenchError) -> CliError {
     match e {
-        magsep::bench::BenchError::Input(m) => CliError::input(m),
-        magsep::bench::BenchError::Runtime(m) => CliError::runtime(m),
+        crate::studies::bench::BenchError::Input(m) => CliError::input(m),
+        crate::studies::bench::BenchError::Runtime(m) => CliError::runtime(m),
     }
 }

@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::scene::{Progress, RunOptions, Scene, load_scene};
+use crate::sim::{SimError, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
-use magsep::prelude::*;
-use magsep::scene::load_scene;
 
-use super::CliError;
+use super::{CliError, Extensions};
 
 /// Set the worker thread count of rayon (kernels) for this process.
 pub fn set_threads(threads: Option<usize>) -> Result<bool, CliError> {
@@ -23,15 +23,19 @@ pub fn set_threads(threads: Option<usize>) -> Result<bool, CliError> {
     Ok(false)
 }
 
-pub fn validate(path: &Path) -> Result<(), CliError> {
-    let scene = load_scene(path, &Default::default())
-        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
+fn load(ext: &Extensions, path: &Path) -> Result<Scene, CliError> {
+    load_scene(path, &ext.registry)
+        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))
+}
+
+pub fn validate(ext: &Extensions, path: &Path) -> Result<(), CliError> {
+    let scene = load(ext, path)?;
     println!(
         "{}",
         serde_json::json!({
             "valid": true,
             "scene": path.display().to_string(),
-            "pipeline": scene.simulation.as_ref().map(|s| s.pipeline),
+            "pipeline": scene.pipeline_name(),
             "particles": scene.total_particles(),
             "fibres": scene.fibres.len(),
         })
@@ -39,7 +43,29 @@ pub fn validate(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A progress bar on stderr (a spinner until the total is known).
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn set_total(&self, steps: u64) {
+        self.0.set_length(steps);
+        self.0.set_style(
+            ProgressStyle::with_template(
+                "[{elapsed_precise}] {bar:40} {pos}/{len} steps ({eta} left) {msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    }
+    fn advance(&self, steps: u64) {
+        self.0.inc(steps);
+    }
+    fn message(&self, text: String) {
+        self.0.set_message(text);
+    }
+}
+
 pub fn run(
+    ext: &Extensions,
     path: &Path,
     record: Option<PathBuf>,
     seed: Option<u64>,
@@ -47,22 +73,14 @@ pub fn run(
     threads: Option<usize>,
 ) -> Result<(), CliError> {
     let single = set_threads(threads)?;
-    let scene = load_scene(path, &Default::default())
-        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
+    let scene = load(ext, path)?;
     let options = RunOptions {
         seed,
         record,
-        pipeline: None,
         single_threaded: single,
-        resume_from: None,
+        plugins: ext.plugins.clone(),
+        ..Default::default()
     };
-    if let Some(section) = scene.brownian_section() {
-        return run_brownian(&scene, section, &options, quiet);
-    }
-    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| match e {
-        magsep::sim::SimError::NothingToRun => CliError::input(e.to_string()),
-        e => CliError::runtime(e.to_string()),
-    })?;
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
@@ -72,57 +90,17 @@ pub fn run(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
-    let summary = sim
-        .run(|w| {
-            if let Some(s) = w.get_resource::<PackingStatus>() {
-                bar.set_message(format!(
-                    "phi {:.4}  steps {}  failed {}  moves {}",
-                    s.packing_fraction, s.compression_steps, s.failed_steps, s.attempts
-                ));
-                bar.tick();
-            }
-        })
-        .map_err(|e| CliError::runtime(e.to_string()))?;
+    let summary = run_scene(&scene, &options, &Bar(bar.clone())).map_err(|e| match e {
+        SimError::NothingToRun => CliError::input(e.to_string()),
+        e => CliError::runtime(e.to_string()),
+    })?;
     bar.finish_and_clear();
     println!(
         "{}",
         serde_json::to_string_pretty(&summary).unwrap_or_default()
     );
-    if summary["stop_reason"] == "budget_too_small" {
-        return Err(CliError::runtime(
-            "no compression step succeeded: the volume step is too large for the attempt budget (see warnings)",
-        ));
+    if let Some(why) = scene.pipeline.as_ref().and_then(|p| p.failure(&summary)) {
+        return Err(CliError::runtime(why));
     }
-    Ok(())
-}
-
-/// A brownian scene: `runs` replicates in parallel with one progress bar over all steps.
-fn run_brownian(
-    scene: &magsep::scene::Scene,
-    section: &magsep::scene::BrownianSection,
-    options: &RunOptions,
-    quiet: bool,
-) -> Result<(), CliError> {
-    let runs = section.runs();
-    let total = section.steps() * runs;
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(total)
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "[{elapsed_precise}] {bar:40} {pos}/{len} steps ({eta} left) {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("{runs} run(s)"));
-    let summary = magsep::brownian::run_ensemble(scene, runs, options, &|n| bar.inc(n))
-        .map_err(|e| CliError::runtime(e.to_string()))?;
-    bar.finish_and_clear();
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&summary).unwrap_or_default()
-    );
     Ok(())
 }

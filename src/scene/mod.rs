@@ -16,14 +16,10 @@
 //! assert_eq!(errors.0[0].path, "particles[0].shape.radius");
 //! ```
 
-mod brownian;
-#[cfg(test)]
-mod brownian_tests;
+pub mod checks;
 mod fibre_packing;
 mod fibres;
-mod fluid_spawn;
-pub mod packing_geometry;
-pub mod particle_fluid;
+pub mod pipeline;
 mod placement;
 mod sections;
 mod spawn;
@@ -31,62 +27,22 @@ mod spawn;
 mod tests;
 mod validate;
 
-use std::fmt;
 use std::path::Path;
+use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 
-pub use brownian::{BrownianSection, PlacementSpec};
+pub use crate::error::{SceneError, SceneErrors, SpawnError};
 pub use fibre_packing::FibrePackingSpec;
 pub use fibres::{ExternalFieldSection, FibreSpec};
-pub use sections::{
-    ContainerSpec, PackingSection, ParticleGroup, PipelineKind, RecordSection, ShapeSpec,
-    SimulationSection,
+pub use pipeline::{
+    NoProgress, ParseContext, Pipeline, Progress, Registry, RunInfo, RunOptions, SceneSection,
 };
-pub use spawn::{RecordEvery, SceneText, SpawnError, spawn_scene, spawn_scene_with};
-
-/// One problem in a scene: where (a key path such as `particles[2].shape.radius`) and what.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct SceneError {
-    /// Key path, `(syntax)` for TOML syntax errors, `(file)` for I/O.
-    pub path: String,
-    /// What is wrong, with the offending value.
-    pub message: String,
-}
-
-impl SceneError {
-    /// A new error at `path`.
-    pub fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            path: path.into(),
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.path, self.message)
-    }
-}
-
-/// All problems found in a scene (never empty when returned as an error).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct SceneErrors(pub Vec<SceneError>);
-
-impl fmt::Display for SceneErrors {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, e) in self.0.iter().enumerate() {
-            if i > 0 {
-                writeln!(f)?;
-            }
-            write!(f, "{e}")?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for SceneErrors {}
+pub use placement::{DensityRatios, PlacementSpec};
+pub use sections::{
+    GROUP_KEYS, PIPELINE_GROUP_KEYS, ParticleGroup, RecordSection, ShapeSpec, SimulationSection,
+};
+pub use spawn::{RecordEvery, SceneText, spawn_scene, spawn_scene_with};
 
 /// A scene entity kind contributed by a plugin: a top-level key of the scene file.
 pub trait SceneKind: Send + Sync {
@@ -101,81 +57,55 @@ pub trait SceneKind: Send + Sync {
     fn spawn(&self, value: &toml::Value, world: &mut World) -> Result<(), SpawnError>;
 }
 
-/// Registered plugin scene kinds.
-#[derive(Default)]
-pub struct SceneRegistry {
-    kinds: Vec<Box<dyn SceneKind>>,
-}
-
-impl SceneRegistry {
-    /// Register a kind (its key must not be a core key).
-    pub fn register(&mut self, kind: Box<dyn SceneKind>) {
-        self.kinds.push(kind);
-    }
-
-    /// The kind registered for `key`.
-    pub fn get(&self, key: &str) -> Option<&dyn SceneKind> {
-        self.kinds
-            .iter()
-            .find(|k| k.key() == key)
-            .map(|k| k.as_ref())
-    }
-
-    fn keys(&self) -> Vec<String> {
-        self.kinds.iter().map(|k| k.key().to_string()).collect()
-    }
-}
-
 /// A parsed and validated scene.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone)]
 pub struct Scene {
     /// The file's text, verbatim (recorded in the recording's metadata).
     pub text: String,
     /// `[simulation]` (absent in a field-only scene).
     pub simulation: Option<SimulationSection>,
-    /// `[container]` (absent in a field-only scene).
-    pub container: Option<ContainerSpec>,
+    /// The pipeline `[simulation]` names (absent in a field-only scene).
+    pub pipeline: Option<Arc<dyn Pipeline>>,
+    /// The pipeline's own validated sections (see [`Scene::section`]).
+    pub section: Option<SceneSection>,
     /// `[[fibres]]`, in file order.
     pub fibres: Vec<FibreSpec>,
     /// `[external_field]`.
     pub external_field: Option<ExternalFieldSection>,
     /// `[[particles]]`, in file order (particle ids follow this order).
     pub particles: Vec<ParticleGroup>,
-    /// `[packing]` (all keys optional).
-    pub packing: PackingSection,
     /// `[record]`.
     pub record: Option<RecordSection>,
-    /// `[brownian]` (the brownian pipeline).
-    pub brownian: Option<BrownianSection>,
-    /// `[particle_fluid]`, `[liquid]`, `[magnet]`, `[collisions]` and the container of the
-    /// particle_fluid pipeline.
-    pub particle_fluid: Option<particle_fluid::ParticleFluidScene>,
     /// Plugin kinds: (key, value) in file order.
     pub extensions: Vec<(String, toml::Value)>,
 }
 
-/// The core top-level keys.
-pub const CORE_KEYS: &[&str] = &[
+impl std::fmt::Debug for Scene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scene")
+            .field("pipeline", &self.pipeline_name())
+            .field("particles", &self.particles)
+            .field("fibres", &self.fibres)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The top-level keys every scene may hold (a pipeline adds its own, see
+/// [`Pipeline::sections`]).
+pub const COMMON_KEYS: &[&str] = &[
     "simulation",
-    "container",
     "particles",
-    "packing",
     "record",
     "fibres",
     "fibre_packings",
     "external_field",
-    "brownian",
-    "particle_fluid",
-    "liquid",
-    "magnet",
-    "collisions",
 ];
 
 /// Parse and validate a scene; every problem is reported.
 ///
 /// # Errors
 /// [`SceneErrors`] with one entry per problem.
-pub fn parse_scene(text: &str, registry: &SceneRegistry) -> Result<Scene, SceneErrors> {
+pub fn parse_scene(text: &str, registry: &Registry) -> Result<Scene, SceneErrors> {
     validate::parse_and_validate(text, registry).map_err(SceneErrors)
 }
 
@@ -183,7 +113,7 @@ pub fn parse_scene(text: &str, registry: &SceneRegistry) -> Result<Scene, SceneE
 ///
 /// # Errors
 /// [`SceneErrors`]; an unreadable file is one error with path `(file)`.
-pub fn load_scene(path: &Path, registry: &SceneRegistry) -> Result<Scene, SceneErrors> {
+pub fn load_scene(path: &Path, registry: &Registry) -> Result<Scene, SceneErrors> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         SceneErrors(vec![SceneError::new(
             "(file)",
@@ -206,15 +136,20 @@ impl Scene {
         (sources, b_ext, tol)
     }
 
-    /// The `[brownian]` section when the scene runs the brownian pipeline.
-    pub fn brownian_section(&self) -> Option<&BrownianSection> {
-        match &self.simulation {
-            Some(SimulationSection {
-                pipeline: PipelineKind::Brownian,
-                ..
-            }) => self.brownian.as_ref(),
-            _ => None,
-        }
+    /// The pipeline's validated scene data as `T` (e.g. a pipeline's section struct).
+    pub fn section<T: std::any::Any>(&self) -> Option<&T> {
+        self.section.as_ref().and_then(|s| s.get::<T>())
+    }
+
+    /// Replace the pipeline's scene data (e.g. a study that shortens a run): `value` must be
+    /// the type the pipeline's [`Pipeline::parse`] returns. The scene is not re-validated.
+    pub fn set_section<T: std::any::Any + Send + Sync>(&mut self, value: T) {
+        self.section = Some(SceneSection::new(value));
+    }
+
+    /// The name of the scene's pipeline (`None` in a field-only scene).
+    pub fn pipeline_name(&self) -> Option<&'static str> {
+        self.pipeline.as_ref().map(|p| p.name())
     }
 
     /// Whether this is a field-only scene (fibres and an external field, nothing to run).

@@ -1,138 +1,114 @@
-//! Spawning the particles of a brownian scene in their start regions.
+//! Start regions and densities of `[[particles]]` groups, shared by the pipelines that place
+//! particles (brownian, particle_fluid and plugin pipelines). SI units.
 
-use bevy_ecs::prelude::*;
 use glam::DVec3;
-use magsep_components::prelude::*;
-use magsep_systems::field::CylinderSource;
-use magsep_systems::rng::particle_stream;
-use rand::RngExt;
-use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::{Deserialize, Serialize};
 
-use super::{BrownianSection, PlacementSpec, Scene, SpawnError};
+use super::FibreSpec;
 
-/// Rejection attempts per particle before the region is declared too full.
-const MAX_ATTEMPTS: usize = 10_000;
-
-/// A uniform random point of `placement` for a particle of radius `a`.
-fn sample(
-    placement: &PlacementSpec,
-    sources: &[CylinderSource],
-    k: usize,
-    rng: &mut Xoshiro256PlusPlus,
-) -> DVec3 {
-    use std::f64::consts::TAU;
-    match placement {
-        PlacementSpec::Box { min, max } => {
-            let (lo, hi) = (DVec3::from_array(*min), DVec3::from_array(*max));
-            lo + (hi - lo) * DVec3::new(rng.random(), rng.random(), rng.random())
-        }
-        PlacementSpec::FibreTop { fibre, gap, height } => {
-            let f = &sources[*fibre];
-            let axis = f.axis();
-            let (u, v) = any_perpendicular(axis);
-            let r = f.radius * rng.random::<f64>().sqrt();
-            let t = TAU * rng.random::<f64>();
-            let z = f.half_length + gap + height * rng.random::<f64>();
-            f.center + axis * z + (u * t.cos() + v * t.sin()) * r
-        }
-        PlacementSpec::FibreSide {
-            fibre,
-            gap,
-            thickness,
-        } => {
-            let f = &sources[*fibre];
-            let axis = f.axis();
-            let (u, v) = any_perpendicular(axis);
-            let (r0, r1) = (f.radius + gap, f.radius + gap + thickness);
-            let r = (r0 * r0 + (r1 * r1 - r0 * r0) * rng.random::<f64>()).sqrt();
-            let t = TAU * rng.random::<f64>();
-            let z = f.half_length * (2.0 * rng.random::<f64>() - 1.0);
-            f.center + axis * z + (u * t.cos() + v * t.sin()) * r
-        }
-        PlacementSpec::Points { positions } => DVec3::from_array(positions[k]),
-        // rejected by validation for brownian scenes
-        PlacementSpec::Injection { .. } => DVec3::ZERO,
-    }
+/// Where a group's particles start.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PlacementSpec {
+    /// Uniform in an axis-aligned box [m].
+    Box {
+        /// Lower corner [m].
+        min: [f64; 3],
+        /// Upper corner [m].
+        max: [f64; 3],
+    },
+    /// Above the `+axis` end face of a fibre (the thesis's TOP region).
+    FibreTop {
+        /// Fibre index in `[[fibres]]`.
+        fibre: usize,
+        /// Distance of the nearest centres from the face [m]. Range: > particle radius.
+        gap: f64,
+        /// Height of the slab [m]. Range: > 0.
+        height: f64,
+    },
+    /// Around the lateral surface of a fibre (the thesis's SIDE region).
+    FibreSide {
+        /// Fibre index in `[[fibres]]`.
+        fibre: usize,
+        /// Distance of the nearest centres from the surface [m]. Range: > particle radius.
+        gap: f64,
+        /// Thickness of the annulus [m]. Range: > 0.
+        thickness: f64,
+    },
+    /// Explicit centres [m] (one per particle).
+    Points {
+        /// Centres [m].
+        positions: Vec<[f64; 3]>,
+    },
+    /// Density-separation injection (particle_fluid; thesis 002 §2.5.3): particles denser than
+    /// the liquid start in the `heavy` height band, lighter ones in the `light` band, except a
+    /// fraction `impurity` of each that starts in the other band; uniform over the container's
+    /// x and y, without overlap.
+    Injection {
+        /// [z_min, z_max] of the heavy particles' band [m].
+        heavy: [f64; 2],
+        /// [z_min, z_max] of the light particles' band [m].
+        light: [f64; 2],
+        /// Imp: fraction of each kind in the wrong band (0: pre-separated, 0.5: random).
+        impurity: f64,
+    },
 }
 
-/// Two unit vectors completing `axis` to a right-handed frame.
-fn any_perpendicular(axis: DVec3) -> (DVec3, DVec3) {
-    let u = axis.any_orthonormal_vector();
-    (u, axis.cross(u))
+fn fibre_dims(fibres: &[FibreSpec], k: usize) -> Option<(f64, f64)> {
+    fibres.get(k).map(|f| {
+        let FibreSpec::Cylinder {
+            radius,
+            half_length,
+            ..
+        } = f;
+        (*radius, *half_length)
+    })
 }
 
-/// Spawn the particles of a brownian scene and the pipeline's resources.
-///
-/// # Errors
-/// [`SpawnError::Other`] when a region is too full to place a particle without overlap.
-pub fn spawn_brownian(
-    scene: &Scene,
-    section: &BrownianSection,
-    world: &mut World,
-    seed: u64,
-) -> Result<(), SpawnError> {
-    let (sources, _, _) = scene.field_sources();
-    let mut placed: Vec<(DVec3, f64)> = Vec::new();
-    let mut id = 0u64;
-    for (g, group) in scene.particles.iter().enumerate() {
-        let a = group.shape.shape().radius();
-        let Some(placement) = &group.placement else {
-            continue;
-        };
-        for k in 0..group.count as usize {
-            let mut rng = particle_stream(seed, id);
-            let explicit = matches!(placement, PlacementSpec::Points { .. });
-            let mut found = None;
-            for _ in 0..MAX_ATTEMPTS {
-                let p = sample(placement, &sources, k, &mut rng);
-                let clear = placed.iter().all(|(q, b)| (p - *q).length() >= a + b)
-                    && sources.iter().all(|s| s.distance(p) > a);
-                if clear || explicit {
-                    found = Some(p);
-                    break;
-                }
+impl PlacementSpec {
+    /// Volume of the start region [m³] (the weight of a group in volume-weighted averages;
+    /// `None` for explicit points).
+    pub fn volume(&self, fibres: &[FibreSpec]) -> Option<f64> {
+        use std::f64::consts::PI;
+        match self {
+            Self::Box { min, max } => {
+                Some((DVec3::from_array(*max) - DVec3::from_array(*min)).element_product())
             }
-            let Some(p) = found else {
-                return Err(SpawnError::Other(format!(
-                    "particles[{g}]: no overlap-free place for particle {k} after {MAX_ATTEMPTS} \
-                     attempts (start region too small for count = {})",
-                    group.count
-                )));
-            };
-            placed.push((p, a));
-            world.spawn((
-                ParticleBundle {
-                    id: ParticleId(id),
-                    position: Position(p),
-                    orientation: Orientation::default(),
-                    shape: group.shape.shape(),
-                    species: Species(g as u32),
-                    rng: ParticleRng(rng),
-                    net_force: NetForce::default(),
-                    net_torque: NetTorque::default(),
-                },
-                group.moment.unwrap_or_default(),
-                InitialPosition(p),
-                Captured::default(),
-                MagneticMoment::default(),
-                (
-                    FieldForce::default(),
-                    DipoleForce::default(),
-                    ContactForce::default(),
-                ),
-            ));
-            id += 1;
+            Self::FibreTop { fibre, height, .. } => {
+                fibre_dims(fibres, *fibre).map(|(r, _)| PI * r * r * height)
+            }
+            Self::FibreSide {
+                fibre,
+                gap,
+                thickness,
+            } => fibre_dims(fibres, *fibre).map(|(r, h)| {
+                let (r0, r1) = (r + gap, r + gap + thickness);
+                PI * (r1 * r1 - r0 * r0) * 2.0 * h
+            }),
+            Self::Points { .. } | Self::Injection { .. } => None,
         }
     }
-    world.insert_resource(crate::brownian::StartRegions(
-        scene
-            .particles
-            .iter()
-            .map(|g| g.placement.as_ref().and_then(|p| p.volume(&scene.fibres)))
-            .collect(),
-    ));
-    world.insert_resource(Container::Unbounded);
-    world.insert_resource(section.config());
-    world.insert_resource(StepClock::new(section.time_step));
-    Ok(())
+}
+
+/// Density of the particles of a group: one value or evenly spaced ratios ρ_p/ρ_f.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DensityRatios {
+    /// Smallest ρ_p/ρ_f. Range > 0.
+    pub min: f64,
+    /// Largest ρ_p/ρ_f. Range >= min.
+    pub max: f64,
+    /// Number of groups (particle k of the group gets group k mod `groups`). Range >= 1.
+    pub groups: u32,
+}
+
+impl DensityRatios {
+    /// ρ_p/ρ_f of group `k`.
+    pub fn ratio(&self, k: u32) -> f64 {
+        if self.groups <= 1 {
+            self.min
+        } else {
+            self.min + (self.max - self.min) * f64::from(k) / f64::from(self.groups - 1)
+        }
+    }
 }

@@ -1,65 +1,21 @@
 //! Typed scene sections (serde, `deny_unknown_fields`, tagged enums). SI units.
 
 use glam::DVec3;
-use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
 use magsep_components::shape::Shape;
 use serde::{Deserialize, Serialize};
 
 use super::Scene;
 
-/// Which pipeline runs the scene.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PipelineKind {
-    /// Mechanical contraction (random dense packings).
-    Packing,
-    /// Brownian dynamics of magnetic nanoparticles around magnetised fibres.
-    Brownian,
-    /// Inertial particles in a magnetised liquid (density separation), one-way coupled.
-    ParticleFluid,
-}
-
 /// `[simulation]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimulationSection {
-    /// Pipeline.
-    pub pipeline: PipelineKind,
+    /// Name of the pipeline that runs the scene (one registered in the
+    /// [`Registry`](super::Registry): `packing`, `brownian`, `particle_fluid` or a plugin's).
+    pub pipeline: String,
     /// Seed of every random stream. Default 0.
     #[serde(default)]
     pub seed: u64,
-}
-
-/// `[container]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ContainerSpec {
-    /// A periodic cube; its edge follows from `packing.initial_packing_fraction`.
-    PeriodicBox {},
-    /// A hard cylinder wall (thesis 000, ch. 2), periodic along its axis (z) and compressed
-    /// along it only; its start length follows from `packing.initial_packing_fraction`.
-    Cylinder {
-        /// Radius of the cylinder R_cyl = D_cyl / 2 [m], fixed. Range: > the largest
-        /// particle radius.
-        radius: f64,
-    },
-    /// A hard wedge prism (thesis 000, ch. 2): bottom y = 0, back x = `length`, slope
-    /// y = x tan(`angle`); periodic in z (its width) and compressed along it only.
-    Wedge {
-        /// Acute angle alpha between bottom and slope [rad]. Range: (0, pi/2).
-        angle: f64,
-        /// Length l_w of the wedge along x [m], fixed. Range: > 0 and room for a particle.
-        length: f64,
-    },
-    /// Two hard walls z = 0 and z = height, periodic in x and y with the fixed side `side`;
-    /// compressed along z; the start height follows from `packing.initial_packing_fraction`.
-    Slab {
-        /// Periodic side along x and y [m]. Range: > 0.
-        side: f64,
-    },
-    /// A closed box of six hard walls, compressed isotropically; its start edge follows from
-    /// `packing.initial_packing_fraction`.
-    ClosedBox {},
 }
 
 /// A particle shape in a scene.
@@ -148,13 +104,13 @@ pub struct ParticleGroup {
     pub moment: Option<magsep_components::brownian::MomentModel>,
     /// Start region (brownian and particle_fluid pipelines; required there).
     #[serde(default)]
-    pub placement: Option<super::brownian::PlacementSpec>,
+    pub placement: Option<super::placement::PlacementSpec>,
     /// Particle density ρ_p [kg/m³] (particle_fluid).
     #[serde(default)]
     pub density: Option<f64>,
     /// Evenly spaced density ratios ρ_p/ρ_f instead of one `density` (particle_fluid).
     #[serde(default)]
-    pub density_ratios: Option<super::particle_fluid::DensityRatios>,
+    pub density_ratios: Option<super::placement::DensityRatios>,
     /// Initial velocity [m/s] (particle_fluid). Default zero.
     #[serde(default)]
     pub velocity: Option<[f64; 3]>,
@@ -162,39 +118,35 @@ pub struct ParticleGroup {
     /// (particle_fluid).
     #[serde(default)]
     pub volume_fraction: Option<f64>,
+    /// Keys of this group that are not fields above, for a plugin pipeline to read (it
+    /// declares them in [`Pipeline::particle_keys`](super::Pipeline::particle_keys)).
+    #[serde(skip)]
+    pub extra: toml::Table,
 }
 
-/// `[packing]`: every key optional (see `PackingConfig` for meanings and defaults).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PackingSection {
-    /// Overlap-removal rule. Default `fire`.
-    pub scheme: Option<OverlapRemovalScheme>,
-    /// Start packing fraction. Default 0.05. Range (0, 0.3].
-    pub initial_packing_fraction: Option<f64>,
-    /// Volume step [m^3]. Default 0.1 D^3.
-    pub volume_step: Option<f64>,
-    /// Step rule. Default `adaptive`.
-    pub volume_step_rule: Option<VolumeStepRule>,
-    /// Adaptive rule's initial free-volume fraction. Default 0.01. Range (0, 0.5].
-    pub adaptive_initial_fraction: Option<f64>,
-    /// Attempt budget per compression step. Default 20000 N (fire), 200 N (others).
-    pub max_attempts: Option<u64>,
-    /// Halvings before the stop. Default 4. Range 0..=30.
-    pub step_halvings: Option<u32>,
-    /// Overlap tolerance in units of D. Default 1e-4. Range (0, 0.01].
-    pub overlap_tolerance: Option<f64>,
-    /// Revised Delta t. Default 0.1. Range (0, 10].
-    pub revised_dt: Option<f64>,
-    /// Original beta. Default 0.5. Range (0, 1].
-    pub original_beta: Option<f64>,
-    /// Original xi [m^2]. Default: I_xy / m per particle.
-    pub original_xi: Option<f64>,
-    /// Step limit. Default 10^7.
-    pub max_compression_steps: Option<u64>,
-    /// Observe every n steps (0: final only). Default 0.
-    pub observe_every: Option<u64>,
-}
+/// The `[[particles]]` keys [`ParticleGroup`] types itself; any other key of a group is
+/// moved to [`ParticleGroup::extra`] before typing.
+pub const GROUP_KEYS: &[&str] = &[
+    "count",
+    "shape",
+    "moment",
+    "placement",
+    "density",
+    "density_ratios",
+    "velocity",
+    "volume_fraction",
+];
+
+/// The typed [`ParticleGroup`] keys that only some pipelines read (the rest, `count` and
+/// `shape`, every pipeline reads).
+pub const PIPELINE_GROUP_KEYS: &[&str] = &[
+    "moment",
+    "placement",
+    "density",
+    "density_ratios",
+    "velocity",
+    "volume_fraction",
+];
 
 /// `[record]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -240,36 +192,5 @@ impl Scene {
             .map(|g| 2.0 * g.shape.shape().radius())
             .fold(f64::INFINITY, f64::min);
         if d.is_finite() { d } else { 1.0 }
-    }
-
-    /// The packing configuration with every default resolved.
-    pub fn packing_config(&self) -> PackingConfig {
-        let n = self.total_particles() as usize;
-        let mut c = PackingConfig::defaults_for(n, self.reference_diameter());
-        let p = &self.packing;
-        if let Some(v) = p.scheme {
-            c.scheme = v;
-            c.max_attempts = PackingConfig::default_max_attempts(v, n);
-        }
-        macro_rules! take {
-            ($($f:ident),*) => { $( if let Some(v) = p.$f { c.$f = v; } )* };
-        }
-        take!(
-            initial_packing_fraction,
-            volume_step,
-            volume_step_rule,
-            adaptive_initial_fraction,
-            max_attempts,
-            step_halvings,
-            overlap_tolerance,
-            revised_dt,
-            original_beta,
-            max_compression_steps,
-            observe_every
-        );
-        if p.original_xi.is_some() {
-            c.original_xi = p.original_xi;
-        }
-        c
     }
 }

@@ -20,7 +20,7 @@ step_halvings = 4
 "#;
 
 fn errors(text: &str) -> Vec<SceneError> {
-    parse_scene(text, &SceneRegistry::default())
+    parse_scene(text, &Registry::default())
         .expect_err("must be invalid")
         .0
 }
@@ -31,9 +31,9 @@ fn has(errs: &[SceneError], path: &str) -> bool {
 
 #[test]
 fn the_issue_example_parses_with_defaults_resolved() {
-    let s = parse_scene(GOOD, &SceneRegistry::default()).unwrap();
+    let s = parse_scene(GOOD, &Registry::default()).unwrap();
     assert_eq!(s.total_particles(), 500);
-    let c = s.packing_config();
+    let c = crate::packing::packing_config(&s);
     assert_eq!(c.max_attempts, 100_000);
     assert_eq!(
         c.scheme,
@@ -42,9 +42,7 @@ fn the_issue_example_parses_with_defaults_resolved() {
     assert_eq!(s.shapes()[0].half_length(), 2.0);
     // omitted [packing]: documented defaults
     let bare = GOOD.split("[packing]").next().unwrap();
-    let c = parse_scene(bare, &SceneRegistry::default())
-        .unwrap()
-        .packing_config();
+    let c = crate::packing::packing_config(&parse_scene(bare, &Registry::default()).unwrap());
     assert_eq!(c.max_attempts, 20_000 * 500);
     assert!((c.volume_step - 0.1).abs() < 1e-15);
 }
@@ -139,8 +137,7 @@ impl SceneKind for Magnets {
 
 #[test]
 fn plugins_register_new_scene_kinds() {
-    let mut reg = SceneRegistry::default();
-    reg.register(Box::new(Magnets));
+    let reg = Registry::default().with_kind(Magnets);
     let s = parse_scene(&format!("{GOOD}\n[magnets]\nstrength = 1.5\n"), &reg).unwrap();
     assert_eq!(s.extensions.len(), 1);
     let e = parse_scene(&format!("{GOOD}\n[magnets]\nstrength = -1.0\n"), &reg).unwrap_err();
@@ -177,7 +174,7 @@ fn mutated_scenes_never_panic() {
             }
             l.join("\n")
         };
-        let _ = parse_scene(&text, &SceneRegistry::default());
+        let _ = parse_scene(&text, &Registry::default());
     }
 }
 
@@ -188,8 +185,7 @@ fn every_shipped_scene_is_valid() {
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         if p.extension().is_some_and(|x| x == "toml") {
-            load_scene(&p, &SceneRegistry::default())
-                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            load_scene(&p, &Registry::default()).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
             n += 1;
         }
     }
@@ -208,7 +204,7 @@ half_length = 6e-3
 axis = [1.0, 0.0, 1.0]
 saturation_magnetisation = 985e3
 "#;
-    let scene = parse_scene(ok, &SceneRegistry::default()).unwrap();
+    let scene = parse_scene(ok, &Registry::default()).unwrap();
     assert!(scene.is_field_only() && scene.fibres.len() == 1);
     let (sources, b, tol) = scene.field_sources();
     assert_eq!((b, tol), (glam::DVec3::X, magsep_systems::field::EXACT));
@@ -246,7 +242,7 @@ saturation_magnetisation = 1.0
 [[fibres]]
 kind = "cube"
 "#;
-    let errs = parse_scene(bad, &SceneRegistry::default()).unwrap_err().0;
+    let errs = parse_scene(bad, &Registry::default()).unwrap_err().0;
     let paths: Vec<&str> = errs.iter().map(|e| e.path.as_str()).collect();
     for want in [
         "external_field.field_tolerance",
@@ -265,9 +261,7 @@ kind = "cube"
     // fibres next to particles need the run tables as usual
     let mixed =
         format!("{ok}\n[[particles]]\ncount = 2\nshape = {{ kind = \"sphere\", radius = 1.0 }}\n");
-    let errs = parse_scene(&mixed, &SceneRegistry::default())
-        .unwrap_err()
-        .0;
+    let errs = parse_scene(&mixed, &Registry::default()).unwrap_err().0;
     assert!(errs.iter().any(|e| e.path == "simulation"));
 }
 
@@ -290,7 +284,7 @@ half_length = 1.0
 axis = [0.0, 0.0, 2.0]
 magnetisation = [0.0, 0.0, 1e5]
 "#;
-    let scene = parse_scene(text, &SceneRegistry::default()).unwrap();
+    let scene = parse_scene(text, &Registry::default()).unwrap();
     let mut world = bevy_ecs::prelude::World::new();
     crate::scene::spawn_scene(&scene, &mut world, 1).unwrap();
     let mut q = world.query::<(

@@ -1,0 +1,144 @@
+//! The `brownian` pipeline: Brownian dynamics of magnetic nanoparticles around magnetised
+//! fibres, with capture, replicates run in parallel, replay of the capture curves and resume.
+
+pub mod ensemble;
+pub mod placement;
+pub mod replay;
+pub mod scene;
+#[cfg(test)]
+mod scene_tests;
+pub mod stats;
+pub mod summary;
+
+use bevy_ecs::prelude::*;
+use magsep_components::prelude::*;
+use magsep_plugins::brownian::brownian_pipeline;
+use magsep_plugins::group::PipelineGroup;
+use magsep_plugins::record::{ParticleFrame, Recording, RecordingWriter};
+use magsep_plugins::recorder::{ColourProvider, FrameStatusProviders};
+use serde_json::Value;
+
+use crate::error::{ReplayError, SimError, SpawnError};
+use crate::scene::{
+    ParseContext, Pipeline, Progress, RunInfo, RunOptions, Scene, SceneError, SceneSection,
+    ShapeSpec,
+};
+pub use ensemble::run_ensemble;
+pub use scene::BrownianSection;
+pub use summary::{RunResult, StartRegions, run_result, run_summary, summary_of};
+
+/// The brownian pipeline (registered as `brownian`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BrownianPipeline;
+
+impl Pipeline for BrownianPipeline {
+    fn name(&self) -> &'static str {
+        "brownian"
+    }
+
+    fn description(&self) -> &'static str {
+        "Brownian dynamics and capture of magnetic nanoparticles around magnetised fibres"
+    }
+
+    fn sections(&self) -> &'static [&'static str] {
+        // `container` is listed to explain why it does not belong here
+        &["brownian", "container"]
+    }
+
+    fn particle_keys(&self) -> &'static [&'static str] {
+        &["moment", "placement"]
+    }
+
+    fn parse(&self, cx: &mut ParseContext<'_>) -> Option<SceneSection> {
+        if cx.table.contains_key("container") {
+            cx.error(
+                "container",
+                "the brownian pipeline runs in unbounded fluid around the fibres: remove [container]",
+            );
+        }
+        let section = if cx.table.contains_key("brownian") {
+            cx.section::<BrownianSection>("brownian")
+        } else {
+            cx.error(
+                "brownian",
+                "missing required table [brownian] (time_step, duration)",
+            );
+            None
+        };
+        if let Some(b) = &section {
+            scene::validate_section(b, cx.errors);
+        }
+        for (i, g) in cx.particles.iter() {
+            let p = format!("particles[{i}]");
+            match g.shape {
+                ShapeSpec::Sphere { radius } => scene::validate_group(
+                    &p,
+                    g.count,
+                    radius,
+                    g.moment.as_ref(),
+                    g.placement.as_ref(),
+                    cx.fibres,
+                    cx.errors,
+                ),
+                _ => cx.errors.push(SceneError::new(
+                    format!("{p}.shape.kind"),
+                    "the brownian pipeline simulates spheres only",
+                )),
+            }
+        }
+        section.map(SceneSection::new)
+    }
+
+    fn spawn(&self, scene: &Scene, world: &mut World, seed: u64) -> Result<(), SpawnError> {
+        let section = scene
+            .section::<BrownianSection>()
+            .ok_or_else(|| SpawnError::Other("not a brownian scene".into()))?;
+        placement::spawn_brownian(scene, section, world, seed)
+    }
+
+    fn plugins(&self, _scene: &Scene) -> PipelineGroup {
+        brownian_pipeline()
+    }
+
+    fn is_finished(&self, world: &World) -> bool {
+        world
+            .get_resource::<BrownianConfig>()
+            .is_none_or(|c| world.resource::<StepClock>().step >= c.steps)
+    }
+
+    fn total_steps(&self, scene: &Scene) -> Option<u64> {
+        scene.section::<BrownianSection>().map(|s| s.steps())
+    }
+
+    fn summary(&self, world: &World, run: &RunInfo) -> Value {
+        run_summary(world, run.seed, run.wall_time_s)
+    }
+
+    fn run(
+        &self,
+        scene: &Scene,
+        options: &RunOptions,
+        progress: &dyn Progress,
+    ) -> Option<Result<Value, SimError>> {
+        let section = scene.section::<BrownianSection>()?;
+        let runs = section.runs();
+        progress.set_total(section.steps() * runs);
+        progress.message(format!("{runs} run(s)"));
+        Some(run_ensemble(scene, runs, options, &|n| progress.advance(n)))
+    }
+
+    fn prepare_recording(&self, world: &mut World, _writer: &mut RecordingWriter) {
+        world
+            .get_resource_or_init::<FrameStatusProviders>()
+            .set("brownian", replay::frame_status);
+        world.insert_resource(ColourProvider(replay::capture_colours));
+    }
+
+    fn replay(&self, rec: &Recording, scene: &Scene, seed: u64) -> Result<Value, ReplayError> {
+        replay::replay_brownian(rec, scene, seed)
+    }
+
+    fn apply_frame(&self, world: &mut World, frame: &ParticleFrame) -> Result<(), ReplayError> {
+        replay::apply_frame(world, frame)
+    }
+}

@@ -1,0 +1,323 @@
+//! `[brownian]` and the Brownian keys of `[[particles]]` (`moment`, `placement`): Brownian
+//! dynamics around magnetised fibres (thesis 000, ch. 6). SI units.
+//!
+//! ```toml
+//! [simulation]
+//! pipeline = "brownian"
+//! seed = 1
+//!
+//! [brownian]
+//! time_step = 5e-5          # dt [s] (outer step; the adaptive stepper bisects it as needed)
+//! duration = 50.0           # [s]
+//! runs = 30                 # independent replicates, run in parallel
+//! temperature = 298.0       # [K]
+//! viscosity = 1.0e-3        # [Pa s]
+//! mobility = "auto"         # free_draining | cholesky | tea | krylov | auto
+//! step_control = { kind = "adaptive", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }
+//! contact = { kind = "mie", epsilon_kt = 100.0, n = 30.0, m = 15.0 }   # or hard_core, none
+//! dipole_cutoff = 30.0      # in mean radii of the pair; 0 switches dipole forces off
+//! captured_interact = true  # captured particles keep exerting dipole/contact forces
+//!
+//! [[particles]]
+//! count = 100
+//! shape = { kind = "sphere", radius = 75e-9 }
+//! moment = { kind = "saturated", moment = 0.87e-16 }      # [A m²]
+//! placement = { kind = "fibre_top", fibre = 0, gap = 1e-6, height = 300e-6 }
+//! ```
+//!
+//! Start regions (the thesis's TOP and SIDE, fig. 6.2, whose sizes it does not give):
+//! * `fibre_top`: centres uniform in the disc-shaped slab above the `+axis` end face of fibre
+//!   `fibre`, with the fibre's radius, from `gap` to `gap + height` above the face.
+//! * `fibre_side`: centres uniform in the annulus around the lateral surface, from `gap` to
+//!   `gap + thickness` off the surface, over the fibre's length.
+//! * `box`: uniform in an axis-aligned box `min`..`max`. `points`: explicit centres.
+//!
+//! Particles do not overlap each other at the start (rejection sampling per particle).
+
+use magsep_components::brownian::{
+    BrownianConfig, ContactModel, MobilityChoice, MomentModel, StepControl,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::scene::{FibreSpec, PlacementSpec, SceneError};
+
+/// `[brownian]`: every key but `time_step` and `duration` optional.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BrownianSection {
+    /// Outer time step dt [s]. Range (0, 1].
+    pub time_step: f64,
+    /// Simulated time [s]. Range [dt, 1e6].
+    pub duration: f64,
+    /// Independent replicates. Default 1. Range 1..=10000.
+    #[serde(default)]
+    pub runs: Option<u64>,
+    /// Temperature [K]. Default 298.
+    #[serde(default)]
+    pub temperature: Option<f64>,
+    /// Viscosity [Pa s]. Default 1e-3 (water).
+    #[serde(default)]
+    pub viscosity: Option<f64>,
+    /// Mobility. Default `auto`.
+    #[serde(default)]
+    pub mobility: Option<MobilityChoice>,
+    /// Krylov tolerance. Default 1e-6. Range (0, 0.1].
+    #[serde(default)]
+    pub krylov_tolerance: Option<f64>,
+    /// Time stepping. Default adaptive (tolerance 1e-2, max_displacement 0.5, max_depth 24).
+    #[serde(default)]
+    pub step_control: Option<StepControl>,
+    /// Excluded volume. Default Mie(30, 15) with ε = 100 k_B T.
+    #[serde(default)]
+    pub contact: Option<ContactModel>,
+    /// Dipole cut-off in mean radii of a pair; 0 switches dipole forces off. Default 30.
+    #[serde(default)]
+    pub dipole_cutoff: Option<f64>,
+    /// Whether captured particles keep exerting pair forces. Default true.
+    #[serde(default)]
+    pub captured_interact: Option<bool>,
+    /// Capture-curve sampling interval in steps. Default: steps / 200 (at least 1).
+    #[serde(default)]
+    pub observe_every: Option<u64>,
+}
+
+impl BrownianSection {
+    /// Number of outer steps.
+    pub fn steps(&self) -> u64 {
+        (self.duration / self.time_step).round().max(1.0) as u64
+    }
+
+    /// The configuration with every default resolved.
+    pub fn config(&self) -> BrownianConfig {
+        let steps = self.steps();
+        BrownianConfig {
+            temperature: self.temperature.unwrap_or(298.0),
+            viscosity: self.viscosity.unwrap_or(1e-3),
+            steps,
+            mobility: self.mobility.unwrap_or_default(),
+            krylov_tolerance: self.krylov_tolerance.unwrap_or(1e-6),
+            step_control: self.step_control.unwrap_or_default(),
+            contact: self.contact.unwrap_or_default(),
+            dipole_cutoff: match self.dipole_cutoff {
+                Some(0.0) => None,
+                Some(c) => Some(c),
+                None => Some(30.0),
+            },
+            captured_interact: self.captured_interact.unwrap_or(true),
+            observe_every: self.observe_every.unwrap_or((steps / 200).max(1)),
+        }
+    }
+
+    /// Replicates.
+    pub fn runs(&self) -> u64 {
+        self.runs.unwrap_or(1)
+    }
+}
+
+fn positive(errors: &mut Vec<SceneError>, path: &str, v: f64, unit: &str) {
+    if !(v.is_finite() && v > 0.0) {
+        errors.push(SceneError::new(
+            path,
+            format!("must be a finite number > 0{unit}, got {v}"),
+        ));
+    }
+}
+
+/// Check `[brownian]`.
+pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
+    positive(errors, "brownian.time_step", b.time_step, " [s]");
+    if b.time_step > 1.0 {
+        errors.push(SceneError::new(
+            "brownian.time_step",
+            format!("must be <= 1 s, got {}", b.time_step),
+        ));
+    }
+    positive(errors, "brownian.duration", b.duration, " [s]");
+    if b.time_step > 0.0 && b.duration.is_finite() {
+        let steps = b.duration / b.time_step;
+        if !(0.5..=1e11).contains(&steps) {
+            errors.push(SceneError::new(
+                "brownian.duration",
+                format!("must give 1 to 1e11 steps of time_step, got {steps:.3e}"),
+            ));
+        }
+    }
+    if let Some(r) = b.runs
+        && !(1..=10_000).contains(&r)
+    {
+        errors.push(SceneError::new(
+            "brownian.runs",
+            format!("must be in 1..=10000, got {r}"),
+        ));
+    }
+    if let Some(t) = b.temperature {
+        positive(errors, "brownian.temperature", t, " [K]");
+    }
+    if let Some(v) = b.viscosity {
+        positive(errors, "brownian.viscosity", v, " [Pa s]");
+    }
+    if let Some(t) = b.krylov_tolerance
+        && !(t.is_finite() && t > 0.0 && t <= 0.1)
+    {
+        errors.push(SceneError::new(
+            "brownian.krylov_tolerance",
+            format!("must be in (0, 0.1], got {t}"),
+        ));
+    }
+    if let Some(StepControl::Adaptive {
+        tolerance,
+        max_displacement,
+        max_depth,
+    }) = b.step_control
+    {
+        let p = "brownian.step_control";
+        if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 1.0) {
+            errors.push(SceneError::new(
+                format!("{p}.tolerance"),
+                format!("must be in (0, 1], got {tolerance}"),
+            ));
+        }
+        if !(max_displacement.is_finite() && max_displacement > 0.0 && max_displacement <= 10.0) {
+            errors.push(SceneError::new(
+                format!("{p}.max_displacement"),
+                format!("must be in (0, 10], got {max_displacement}"),
+            ));
+        }
+        if !(1..=40).contains(&max_depth) {
+            errors.push(SceneError::new(
+                format!("{p}.max_depth"),
+                format!("must be in 1..=40, got {max_depth}"),
+            ));
+        }
+    }
+    if let Some(ContactModel::Mie { epsilon_kt, n, m }) = b.contact {
+        let p = "brownian.contact";
+        if !(epsilon_kt.is_finite() && epsilon_kt > 0.0 && epsilon_kt <= 1e6) {
+            errors.push(SceneError::new(
+                format!("{p}.epsilon_kt"),
+                format!("must be in (0, 1e6], got {epsilon_kt}"),
+            ));
+        }
+        if !(m.is_finite() && n.is_finite() && m > 0.0 && n > m && n <= 200.0) {
+            errors.push(SceneError::new(
+                format!("{p}.n"),
+                format!("exponents must satisfy 0 < m < n <= 200, got n = {n}, m = {m}"),
+            ));
+        }
+    }
+    if let Some(c) = b.dipole_cutoff
+        && !(c.is_finite() && (c == 0.0 || (2.0..=1000.0).contains(&c)))
+    {
+        errors.push(SceneError::new(
+            "brownian.dipole_cutoff",
+            format!("must be 0 (off) or in [2, 1000] mean radii, got {c}"),
+        ));
+    }
+    if b.observe_every == Some(0) {
+        errors.push(SceneError::new(
+            "brownian.observe_every",
+            "must be >= 1, got 0",
+        ));
+    }
+}
+
+/// Check a group's `moment` and `placement` (`p` is `particles[i]`, `radius` its radius).
+pub fn validate_group(
+    p: &str,
+    count: u64,
+    radius: f64,
+    moment: Option<&MomentModel>,
+    placement: Option<&PlacementSpec>,
+    fibres: &[FibreSpec],
+    errors: &mut Vec<SceneError>,
+) {
+    match moment {
+        Some(MomentModel::Saturated { moment }) => {
+            positive(errors, &format!("{p}.moment.moment"), *moment, " [A m²]")
+        }
+        Some(MomentModel::Langevin {
+            moment,
+            domain_moment,
+        }) => {
+            positive(errors, &format!("{p}.moment.moment"), *moment, " [A m²]");
+            positive(
+                errors,
+                &format!("{p}.moment.domain_moment"),
+                *domain_moment,
+                " [A m²]",
+            );
+        }
+        _ => {}
+    }
+    let Some(placement) = placement else {
+        errors.push(SceneError::new(
+            format!("{p}.placement"),
+            "missing required key (the brownian pipeline needs a start region)",
+        ));
+        return;
+    };
+    let q = format!("{p}.placement");
+    let check_fibre = |k: usize, errors: &mut Vec<SceneError>| {
+        if k >= fibres.len() {
+            errors.push(SceneError::new(
+                format!("{q}.fibre"),
+                format!("no fibre {k}: the scene has {} [[fibres]]", fibres.len()),
+            ));
+        }
+    };
+    match placement {
+        PlacementSpec::Box { min, max } => {
+            if !(0..3).all(|k| min[k].is_finite() && max[k].is_finite() && max[k] > min[k]) {
+                errors.push(SceneError::new(
+                    format!("{q}.max"),
+                    format!("must exceed min on every axis, got min {min:?}, max {max:?}"),
+                ));
+            }
+        }
+        PlacementSpec::FibreTop { fibre, gap, height } => {
+            check_fibre(*fibre, errors);
+            positive(errors, &format!("{q}.height"), *height, " [m]");
+            if !(gap.is_finite() && *gap > radius) {
+                errors.push(SceneError::new(
+                    format!("{q}.gap"),
+                    format!("must exceed the particle radius {radius} m, got {gap}"),
+                ));
+            }
+        }
+        PlacementSpec::FibreSide {
+            fibre,
+            gap,
+            thickness,
+        } => {
+            check_fibre(*fibre, errors);
+            positive(errors, &format!("{q}.thickness"), *thickness, " [m]");
+            if !(gap.is_finite() && *gap > radius) {
+                errors.push(SceneError::new(
+                    format!("{q}.gap"),
+                    format!("must exceed the particle radius {radius} m, got {gap}"),
+                ));
+            }
+        }
+        PlacementSpec::Injection { .. } => errors.push(SceneError::new(
+            format!("{q}.kind"),
+            "injection is for the particle_fluid pipeline",
+        )),
+        PlacementSpec::Points { positions } => {
+            if positions.len() as u64 != count {
+                errors.push(SceneError::new(
+                    format!("{q}.positions"),
+                    format!("must hold count = {count} points, got {}", positions.len()),
+                ));
+            }
+            if let Some(k) = positions
+                .iter()
+                .position(|p| !p.iter().all(|v| v.is_finite()))
+            {
+                errors.push(SceneError::new(
+                    format!("{q}.positions[{k}]"),
+                    "must be three finite numbers [m]",
+                ));
+            }
+        }
+    }
+}

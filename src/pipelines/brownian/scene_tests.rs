@@ -1,0 +1,135 @@
+//! Validation of brownian scenes: every error with its key path.
+
+use super::*;
+use crate::scene::parse_scene;
+
+const GOOD: &str = r#"
+[simulation]
+pipeline = "brownian"
+[external_field]
+flux_density = [1.0, 0.0, 0.0]
+[[fibres]]
+kind = "cylinder"
+radius = 300e-6
+half_length = 6e-3
+axis = [0.0, 0.0, 1.0]
+saturation_magnetisation = 985e3
+[brownian]
+time_step = 5e-5
+duration = 1.0
+runs = 3
+[[particles]]
+count = 10
+shape = { kind = "sphere", radius = 75e-9 }
+moment = { kind = "saturated", moment = 0.87e-16 }
+placement = { kind = "fibre_top", fibre = 0, gap = 1e-6, height = 300e-6 }
+[[particles]]
+count = 10
+shape = { kind = "sphere", radius = 75e-9 }
+moment = { kind = "langevin", moment = 0.87e-16, domain_moment = 2.3e-19 }
+placement = { kind = "fibre_side", fibre = 0, gap = 1e-6, thickness = 300e-6 }
+"#;
+
+fn errors(text: &str) -> Vec<SceneError> {
+    parse_scene(text, &Default::default()).unwrap_err().0
+}
+
+fn paths(text: &str) -> Vec<String> {
+    errors(text).into_iter().map(|e| e.path).collect()
+}
+
+#[test]
+fn good_scene_parses_with_defaults_and_region_volumes() {
+    let s = parse_scene(GOOD, &Default::default()).unwrap();
+    let b = s.section::<BrownianSection>().unwrap();
+    let c = b.config();
+    assert_eq!(c.steps, 20_000);
+    assert_eq!(c.dipole_cutoff, Some(30.0));
+    assert_eq!(c.observe_every, 100);
+    assert_eq!(b.runs(), 3);
+    let top = s.particles[0]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
+    let pi = std::f64::consts::PI;
+    assert!((top - pi * 300e-6f64.powi(2) * 300e-6).abs() < 1e-20);
+    let side = s.particles[1]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
+    let (r0, r1) = (301e-6f64, 601e-6f64);
+    assert!((side - pi * (r1 * r1 - r0 * r0) * 12e-3).abs() < 1e-18);
+}
+
+#[test]
+fn every_problem_is_reported_with_its_key_path() {
+    let bad = GOOD
+        .replace("time_step = 5e-5", "time_step = -1.0")
+        .replace("runs = 3", "runs = 0")
+        .replace(
+            "fibre = 0, gap = 1e-6, height",
+            "fibre = 4, gap = 1e-9, height",
+        )
+        .replace("moment = 0.87e-16 }", "moment = -1.0 }")
+        .replace("domain_moment = 2.3e-19", "domain_moment = 0.0");
+    let p = paths(&bad);
+    for want in [
+        "brownian.time_step",
+        "brownian.runs",
+        "particles[0].placement.fibre",
+        "particles[0].placement.gap",
+        "particles[0].moment.moment",
+        "particles[1].moment.domain_moment",
+    ] {
+        assert!(p.iter().any(|x| x == want), "{want} missing in {p:?}");
+    }
+}
+
+#[test]
+fn pipeline_specific_keys_are_checked() {
+    // container is not allowed (unbounded fluid); [brownian] is required
+    let p = paths(&GOOD.replace(
+        "[brownian]",
+        "[container]\nkind = \"periodic_box\"\n[brownian]",
+    ));
+    assert!(p.contains(&"container".to_string()), "{p:?}");
+    let p = paths(&GOOD.replace(
+        "[brownian]\ntime_step = 5e-5\nduration = 1.0\nruns = 3\n",
+        "",
+    ));
+    assert!(p.contains(&"brownian".to_string()), "{p:?}");
+    // placement is required, spheres only
+    let p = paths(&GOOD.replace(
+        "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
+        "",
+    ));
+    assert!(p.contains(&"particles[0].placement".to_string()), "{p:?}");
+    let p = paths(&GOOD.replacen(
+        "shape = { kind = \"sphere\", radius = 75e-9 }",
+        "shape = { kind = \"spherocylinder\", radius = 75e-9, cylinder_length = 1e-7 }",
+        1,
+    ));
+    assert!(p.contains(&"particles[0].shape.kind".to_string()), "{p:?}");
+    // typos in nested tables name the key
+    let p = paths(&GOOD.replace("runs = 3", "runs = 3\nstep_control = { kind = \"adaptive\", tolerance = 1e-3, max_displacement = 0.2, max_depht = 3 }"));
+    assert!(
+        p.iter().any(|x| x.starts_with("brownian.step_control")),
+        "{p:?}"
+    );
+    // points must match the count
+    let p = paths(&GOOD.replace(
+        "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
+        "placement = { kind = \"points\", positions = [[0.0, 0.0, 1.0]] }",
+    ));
+    assert!(
+        p.contains(&"particles[0].placement.positions".to_string()),
+        "{p:?}"
+    );
+    // moment and placement belong to the brownian pipeline only
+    let packing = "[simulation]\npipeline = \"packing\"\n[container]\nkind = \"periodic_box\"\n[[particles]]\ncount = 3\nshape = { kind = \"sphere\", radius = 1.0 }\nmoment = { kind = \"saturated\", moment = 1.0 }\n";
+    assert!(paths(packing).contains(&"particles[0].moment".to_string()));
+}

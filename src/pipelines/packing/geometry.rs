@@ -1,0 +1,125 @@
+//! Containers with hard walls and superquadric particles in packing scenes: validation and
+//! the container's start size.
+//!
+//! The fixed dimensions come from the scene (cylinder radius, wedge length and angle, slab
+//! side); the compressed one (cylinder and wedge length along z, slab height, box edge) follows
+//! from `packing.initial_packing_fraction` phi0: V_particles / (phi0 * cross-section).
+
+use glam::DVec3;
+use magsep_components::container::{Container, Walls};
+use magsep_components::packing::OverlapRemovalScheme;
+use magsep_components::shape::Shape;
+
+use super::scene::{ContainerSpec, PackingSection};
+use crate::scene::checks::{check, finite_positive};
+use crate::scene::{ParticleGroup, SceneError, ShapeSpec};
+
+fn is_superquadric(s: &ShapeSpec) -> bool {
+    matches!(
+        s,
+        ShapeSpec::Superquadric { .. } | ShapeSpec::Superball { .. } | ShapeSpec::Ellipsoid { .. }
+    )
+}
+
+/// Cross-shape, scheme and container checks of a packing scene (after the per-field checks
+/// passed).
+pub(crate) fn validate(
+    container: Option<&ContainerSpec>,
+    groups: &[&ParticleGroup],
+    packing: &PackingSection,
+    errors: &mut Vec<SceneError>,
+) {
+    let any_sq = groups.iter().any(|g| is_superquadric(&g.shape));
+    for (i, g) in groups.iter().enumerate() {
+        if any_sq
+            && let ShapeSpec::Spherocylinder {
+                cylinder_length, ..
+            } = g.shape
+            && cylinder_length > 0.0
+        {
+            errors.push(SceneError::new(
+                format!("particles[{i}].shape.kind"),
+                "spherocylinders cannot be mixed with superquadrics in one packing (spheres can)",
+            ));
+        }
+    }
+    if any_sq && packing.scheme == Some(OverlapRemovalScheme::Original) {
+        errors.push(SceneError::new(
+            "packing.scheme",
+            "the original (Williams-Philipse) scheme is defined for spheres and spherocylinders \
+             only; use \"revised\" or \"fire\" with superquadrics",
+        ));
+    }
+    let shapes: Vec<Shape> = groups.iter().map(|g| g.shape.shape()).collect();
+    let largest_bound = shapes
+        .iter()
+        .map(magsep_systems::geometry::bounding_radius)
+        .fold(0.0, f64::max);
+    let largest_radius = shapes.iter().map(|s| s.radius()).fold(0.0, f64::max);
+    // what must fit across the container: a rod's cap, a superquadric's bounding sphere
+    let needed = if any_sq {
+        largest_bound
+    } else {
+        largest_radius
+    };
+    match container {
+        Some(ContainerSpec::Cylinder { radius }) => {
+            finite_positive(errors, "container.radius", *radius);
+            check(errors, *radius > needed, "container.radius", || {
+                format!("must exceed the largest particle radius {needed:e} m, got {radius:e}")
+            });
+        }
+        Some(ContainerSpec::Wedge { angle, length }) => {
+            check(
+                errors,
+                angle.is_finite() && *angle > 0.0 && *angle < std::f64::consts::FRAC_PI_2,
+                "container.angle",
+                || format!("must be in (0, pi/2) rad, got {angle}"),
+            );
+            finite_positive(errors, "container.length", *length);
+            let t = angle.tan();
+            let inscribed = length * t / (1.0 + t + 1.0 / angle.cos());
+            check(errors, inscribed > needed, "container.length", || {
+                format!(
+                    "the wedge's inscribed circle (radius {inscribed:e} m) must exceed the \
+                     largest particle radius {needed:e} m"
+                )
+            });
+        }
+        Some(ContainerSpec::Slab { side }) => finite_positive(errors, "container.side", *side),
+        Some(ContainerSpec::PeriodicBox {}) | Some(ContainerSpec::ClosedBox {}) | None => {}
+    }
+}
+
+/// The start container for `particle_volume` [m^3] at packing fraction `phi0`.
+pub fn start_container(spec: &ContainerSpec, particle_volume: f64, phi0: f64) -> Container {
+    let v = particle_volume / phi0;
+    match *spec {
+        ContainerSpec::PeriodicBox {} => Container::PeriodicBox {
+            edges: DVec3::splat(v.cbrt()),
+        },
+        ContainerSpec::ClosedBox {} => Container::Walled {
+            walls: Walls::Box,
+            edges: DVec3::splat(v.cbrt()),
+        },
+        ContainerSpec::Cylinder { radius } => Container::Walled {
+            walls: Walls::Cylinder,
+            edges: DVec3::new(
+                2.0 * radius,
+                2.0 * radius,
+                v / (std::f64::consts::PI * radius * radius),
+            ),
+        },
+        ContainerSpec::Wedge { angle, length } => {
+            let h = length * angle.tan();
+            Container::Walled {
+                walls: Walls::Wedge { angle },
+                edges: DVec3::new(length, h, v / (0.5 * length * h)),
+            }
+        }
+        ContainerSpec::Slab { side } => Container::Walled {
+            walls: Walls::Slab,
+            edges: DVec3::new(side, side, v / (side * side)),
+        },
+    }
+}

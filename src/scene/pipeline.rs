@@ -1,0 +1,316 @@
+//! Pipelines as plugins: the [`Pipeline`] trait and the [`Registry`] that `[simulation]
+//! pipeline = "..."` is looked up in.
+//!
+//! A pipeline is one self-contained unit: the scene sections it owns and their validation,
+//! spawning, its plugin group, its end-of-run condition, its summary, replay and (where it can)
+//! resume. Shared code (the scene parser, the simulation driver, the recorder, replay and the
+//! CLI) only calls these hooks; it never names a pipeline. The built-in pipelines are
+//! registered in `magsep::pipelines` (one line each); a user's binary adds its own with
+//! [`Registry::with_pipeline`] and hands the registry to `magsep::cli::main_with`.
+
+use std::any::Any;
+use std::fmt;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use bevy_ecs::prelude::*;
+use magsep_plugins::app::SimPlugin;
+use magsep_plugins::group::PipelineGroup;
+use magsep_plugins::record::{ParticleFrame, Recording, RecordingWriter};
+use serde_json::Value;
+
+use super::checks::{typed, typed_array};
+use super::{FibreSpec, ParticleGroup, Scene, SceneError, SceneKind, SpawnError};
+use crate::error::{ReplayError, SimError};
+
+/// What a pipeline's [`Pipeline::parse`] sees: the scene's TOML table, the common parts
+/// already typed, and the error list to push to (every error at its key path).
+pub struct ParseContext<'a> {
+    /// The whole scene table (the pipeline reads its own keys, see [`Pipeline::sections`]).
+    pub table: &'a toml::Table,
+    /// `[[particles]]` typed, with their index in the file (entries with errors left out).
+    pub particles: &'a mut Vec<(usize, ParticleGroup)>,
+    /// `[[fibres]]` (and expanded `[[fibre_packings]]`).
+    pub fibres: &'a [FibreSpec],
+    /// Errors found so far; push more.
+    pub errors: &'a mut Vec<SceneError>,
+}
+
+impl ParseContext<'_> {
+    /// The top-level table `key` typed as `T` (`None` if absent or invalid; invalid values
+    /// push errors with their inner key path).
+    pub fn section<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Option<T> {
+        self.table
+            .get(key)
+            .and_then(|v| typed::<T>(v, key, self.errors))
+    }
+
+    /// The top-level array of tables `key` (`[[key]]`), each entry typed with its index.
+    pub fn array<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Vec<(usize, T)> {
+        self.table
+            .get(key)
+            .map(|v| typed_array::<T>(v, key, self.errors))
+            .unwrap_or_default()
+    }
+
+    /// A required top-level table: an error if it is missing.
+    pub fn required<T: serde::de::DeserializeOwned>(
+        &mut self,
+        key: &str,
+        pipeline: &str,
+    ) -> Option<T> {
+        if !self.table.contains_key(key) {
+            self.errors.push(SceneError::new(
+                key,
+                format!("missing required table [{key}] for pipeline = \"{pipeline}\""),
+            ));
+            return None;
+        }
+        self.section(key)
+    }
+
+    /// Push an error at `path`.
+    pub fn error(&mut self, path: impl Into<String>, message: impl Into<String>) {
+        self.errors.push(SceneError::new(path, message));
+    }
+}
+
+/// A pipeline's validated scene data (what [`Pipeline::parse`] returns), read back with
+/// [`Scene::section`].
+#[derive(Clone)]
+pub struct SceneSection(Arc<dyn Any + Send + Sync>);
+
+impl SceneSection {
+    /// Wrap `value`.
+    pub fn new<T: Any + Send + Sync>(value: T) -> Self {
+        Self(Arc::new(value))
+    }
+
+    /// The value as `T`, if it is one.
+    pub fn get<T: Any>(&self) -> Option<&T> {
+        self.0.downcast_ref::<T>()
+    }
+}
+
+impl fmt::Debug for SceneSection {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("SceneSection(..)")
+    }
+}
+
+/// Progress of a run, reported by the driver (a CLI progress bar, or nothing).
+pub trait Progress: Sync {
+    /// The total number of steps, when known (all replicates together).
+    fn set_total(&self, _steps: u64) {}
+    /// `steps` more steps are done.
+    fn advance(&self, _steps: u64) {}
+    /// A status line (e.g. the packing fraction so far).
+    fn message(&self, _text: String) {}
+}
+
+/// No progress report.
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// Options of a run beyond the scene.
+#[derive(Clone, Default)]
+pub struct RunOptions {
+    /// Seed overriding `simulation.seed`.
+    pub seed: Option<u64>,
+    /// Write an MCAP recording here.
+    pub record: Option<PathBuf>,
+    /// Use this plugin group instead of the pipeline's own (a user's edited group).
+    pub pipeline: Option<PipelineGroup>,
+    /// Run the schedule on one thread.
+    pub single_threaded: bool,
+    /// Continue from this recorded frame (see `magsep replay --resume`).
+    pub resume_from: Option<ParticleFrame>,
+    /// Plugins built after the pipeline's group (a user's forces, observers, channels).
+    pub plugins: Vec<Arc<dyn SimPlugin>>,
+}
+
+/// What a summary knows of the run beyond the world.
+#[derive(Debug, Clone, Copy)]
+pub struct RunInfo {
+    /// Seed of the run.
+    pub seed: u64,
+    /// Wall time of the run so far [s].
+    pub wall_time_s: f64,
+}
+
+/// One pipeline. Implement it (and register it in a [`Registry`]) to add a simulation kind
+/// that runs from scenes through `magsep run`, `validate`, `info`, `replay` and the builder.
+///
+/// Only [`name`](Self::name), [`parse`](Self::parse), [`spawn`](Self::spawn),
+/// [`plugins`](Self::plugins), [`is_finished`](Self::is_finished) and
+/// [`summary`](Self::summary) are required; see `examples/langevin_trap` for a complete
+/// pipeline written outside the crate.
+pub trait Pipeline: Send + Sync + 'static {
+    /// The name in `[simulation] pipeline = "..."` (and in recordings).
+    fn name(&self) -> &'static str;
+
+    /// One line on what it simulates (for `magsep validate` and help texts).
+    fn description(&self) -> &'static str {
+        ""
+    }
+
+    /// The top-level scene keys this pipeline owns besides the common ones (`simulation`,
+    /// `particles`, `record`, `fibres`, `fibre_packings`, `external_field`). A key owned by
+    /// another pipeline is an error "only for pipeline = ..." in this pipeline's scenes.
+    fn sections(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// `[[particles]]` keys this pipeline reads beyond `count` and `shape` (a plugin
+    /// pipeline's own keys arrive in [`ParticleGroup::extra`]).
+    fn particle_keys(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Whether a scene of this pipeline needs at least one `[[particles]]` entry.
+    fn needs_particles(&self) -> bool {
+        true
+    }
+
+    /// Type and check this pipeline's sections and particle keys, pushing every problem at
+    /// its key path; the returned data is kept in the [`Scene`].
+    fn parse(&self, cx: &mut ParseContext<'_>) -> Option<SceneSection>;
+
+    /// Spawn the scene's particles and the resources the pipeline's plugins need (the
+    /// driver adds the common ones: fibres, external field, seed, health, record interval).
+    ///
+    /// # Errors
+    /// [`SpawnError`] when placing particles fails.
+    fn spawn(&self, scene: &Scene, world: &mut World, seed: u64) -> Result<(), SpawnError>;
+
+    /// The pipeline's plugin group for this scene.
+    fn plugins(&self, scene: &Scene) -> PipelineGroup;
+
+    /// Whether the run has ended.
+    fn is_finished(&self, world: &World) -> bool;
+
+    /// The number of steps of one run, when known in advance (for progress bars).
+    fn total_steps(&self, _scene: &Scene) -> Option<u64> {
+        None
+    }
+
+    /// A status line for progress bars.
+    fn progress(&self, _world: &World) -> Option<String> {
+        None
+    }
+
+    /// The summary of the current state (printed as JSON by `magsep run`).
+    fn summary(&self, world: &World, run: &RunInfo) -> Value;
+
+    /// Why a finished run counts as failed (exit code 1), judged from its summary.
+    fn failure(&self, _summary: &Value) -> Option<String> {
+        None
+    }
+
+    /// Called once after the schedule is built and before the first step, when recording:
+    /// add what the viewer needs beyond particles (backdrops, colours) to the world or writer.
+    fn prepare_recording(&self, _world: &mut World, _writer: &mut RecordingWriter) {}
+
+    /// Run the scene in a way of the pipeline's own (e.g. replicates in parallel);
+    /// `None` lets the driver run one simulation.
+    ///
+    /// # Errors
+    /// [`SimError`] of the run.
+    fn run(
+        &self,
+        _scene: &Scene,
+        _options: &RunOptions,
+        _progress: &dyn Progress,
+    ) -> Option<Result<Value, SimError>> {
+        None
+    }
+
+    /// The summary recomputed from a recording (`magsep replay`).
+    ///
+    /// # Errors
+    /// [`ReplayError`] when the recording does not fit.
+    fn replay(&self, rec: &Recording, scene: &Scene, seed: u64) -> Result<Value, ReplayError>;
+
+    /// Restore the dynamic state of a recorded frame into a freshly spawned world, bitwise,
+    /// so that the run continues as if never interrupted (`magsep replay --resume`).
+    ///
+    /// # Errors
+    /// [`ReplayError::Unsupported`] when the pipeline cannot resume (the default).
+    fn apply_frame(&self, _world: &mut World, _frame: &ParticleFrame) -> Result<(), ReplayError> {
+        Err(ReplayError::Unsupported(format!(
+            "the {} pipeline does not record enough state to resume a run",
+            self.name()
+        )))
+    }
+}
+
+/// The pipelines and plugin scene kinds a program knows. `Registry::default()` holds the
+/// built-in pipelines (`packing`, `brownian`, `particle_fluid`).
+///
+/// ```
+/// let registry = magsep::scene::Registry::default();
+/// assert!(registry.pipeline("packing").is_some());
+/// assert!(registry.pipeline("no_such_pipeline").is_none());
+/// ```
+#[derive(Clone)]
+pub struct Registry {
+    pipelines: Vec<Arc<dyn Pipeline>>,
+    kinds: Vec<Arc<dyn SceneKind>>,
+}
+
+impl Registry {
+    /// A registry with nothing in it.
+    pub fn empty() -> Self {
+        Self {
+            pipelines: Vec::new(),
+            kinds: Vec::new(),
+        }
+    }
+
+    /// Add `pipeline` (replacing one of the same name).
+    pub fn with_pipeline(mut self, pipeline: impl Pipeline) -> Self {
+        self.register(Arc::new(pipeline));
+        self
+    }
+
+    /// Add `pipeline` (replacing one of the same name).
+    pub fn register(&mut self, pipeline: Arc<dyn Pipeline>) {
+        self.pipelines.retain(|p| p.name() != pipeline.name());
+        self.pipelines.push(pipeline);
+    }
+
+    /// Add a plugin scene kind (a top-level key any pipeline's scene may hold).
+    pub fn with_kind(mut self, kind: impl SceneKind + 'static) -> Self {
+        self.kinds.push(Arc::new(kind));
+        self
+    }
+
+    /// The pipeline named `name`.
+    pub fn pipeline(&self, name: &str) -> Option<&Arc<dyn Pipeline>> {
+        self.pipelines.iter().find(|p| p.name() == name)
+    }
+
+    /// The registered pipelines, in registration order.
+    pub fn pipelines(&self) -> impl Iterator<Item = &Arc<dyn Pipeline>> {
+        self.pipelines.iter()
+    }
+
+    /// Names of the registered pipelines.
+    pub fn names(&self) -> Vec<&'static str> {
+        self.pipelines.iter().map(|p| p.name()).collect()
+    }
+
+    /// The scene kind registered for `key`.
+    pub fn kind(&self, key: &str) -> Option<&dyn SceneKind> {
+        self.kinds
+            .iter()
+            .find(|k| k.key() == key)
+            .map(|k| k.as_ref())
+    }
+
+    /// Keys of the registered scene kinds.
+    pub fn kind_keys(&self) -> Vec<String> {
+        self.kinds.iter().map(|k| k.key().to_string()).collect()
+    }
+}

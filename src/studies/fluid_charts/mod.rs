@@ -1,0 +1,44 @@
+//! Charts and benchmarks of the particle-fluid pipeline (thesis 002, ch. 2): single-particle
+//! levitation, the Basset history's accuracy, cost and stability, binary collisions and the
+//! many-particle separation error.
+//!
+//! * `magsep chart levitation`: [`chart_levitation`].
+//! * `magsep chart history`: [`chart_history`].
+//! * `magsep chart collisions`: [`chart_collisions`].
+//! * `magsep chart separation`: [`chart_separation`].
+//! * `magsep bench particle-fluid`: [`bench_particle_fluid`].
+
+mod bench;
+mod collisions;
+mod history;
+mod levitation;
+mod separation;
+
+pub use bench::bench_particle_fluid;
+pub use collisions::chart_collisions;
+pub use history::chart_history;
+pub use levitation::chart_levitation;
+pub use separation::chart_separation;
+
+use crate::scene::parse_scene;
+use crate::sim::{RunOptions, Simulation};
+use crate::studies::bench::BenchError;
+
+/// A run-time error of a chart or bench.
+pub(crate) fn runtime(e: impl std::fmt::Display) -> BenchError {
+    BenchError::Runtime(e.to_string())
+}
+
+/// The simulation of scene `text`, on the single-threaded executor (charts run scenes in
+/// parallel with rayon instead).
+pub(crate) fn simulation(text: &str) -> Result<Simulation, BenchError> {
+    let scene = parse_scene(text, &Default::default()).map_err(runtime)?;
+    Simulation::from_scene(
+        &scene,
+        RunOptions {
+            single_threaded: true,
+            ..Default::default()
+        },
+    )
+    .map_err(runtime)
+}
