@@ -1,124 +1,38 @@
-//! [`read_recording`]: reads a recording back, tolerating files cut short.
+//! Linear scan of a recording from its start, one record at a time, tolerating files cut short.
 //!
-//! The file is read linearly from the start, so a file without summary or footer (a killed
-//! process) still yields every frame in a complete chunk. Chunks are taken whole: their records
-//! are used only once the chunk has decompressed and passed its CRC. The data-section and
-//! summary CRCs are checked when the file has them.
+//! A file without summary or footer (a killed process) still yields every complete chunk.
+//! Chunks are taken whole: their records are used only once the chunk has decompressed and
+//! passed its CRC. The data-section and summary CRCs are checked when the file has them. Only
+//! one record is in memory at a time (records that are not needed are streamed through the
+//! CRC), and every length is checked against the bytes left in the file and the reader's
+//! limits before anything is read.
 
-use super::parse::{Cursor, check_chunk_header, crc32, hex_prefix, parse_metadata};
-use super::proto::ParticleStateWire;
-use super::{
-    METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, STATE_TOPIC,
-    SUMMARY_METADATA_NAME,
-};
+use super::chunk::{ReaderLimits, decompress, split_records};
+use super::layout::{End, Layout, Unit};
+use super::source::Source;
+use crate::RecordError;
+use crate::parse::{Cursor, hex_prefix};
 use mcap::records::op;
-use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-use std::collections::{BTreeMap, HashMap};
+use std::io::{Read, Seek};
 use std::path::Path;
 
-/// A channel of a recording, with the number of messages read on it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ChannelInfo {
-    /// Topic, e.g. `/state`.
-    pub topic: String,
-    /// Name of the channel's schema, e.g. `magsep.ParticleState` (empty if it has none).
-    pub schema_name: String,
-    /// Message encoding, e.g. `protobuf`.
-    pub message_encoding: String,
-    /// Number of messages read on the channel.
-    pub message_count: u64,
-}
-
-/// Everything read from a recording.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Recording {
-    /// The run's metadata (record `magsep`), if present.
-    pub metadata: Option<RecordingMetadata>,
-    /// All complete `/state` frames, in file order.
-    pub frames: Vec<ParticleFrame>,
-    /// The JSON text of the last `magsep.summary` record, if any.
-    pub summary_json: Option<String>,
-    /// The channels, in channel-id order.
-    pub channels: Vec<ChannelInfo>,
-    /// `None` for a complete, intact file. Otherwise why reading stopped early: the file ends
-    /// before its footer (process killed; the message gives the byte where the file ends and
-    /// the start of the incomplete record), or a damaged record follows the frames read.
-    pub truncated: Option<String>,
-    /// Size of the file (bytes).
-    pub file_bytes: u64,
-}
-
-/// Reads the recording at `path`: metadata, all complete frames, summary and channel list.
-///
-/// A file cut short (no footer) gives `Ok` with the frames read and
-/// [`Recording::truncated`] set. Data that is not MCAP gives [`RecordError::NotMcap`]; a damaged
-/// record gives [`RecordError::Corrupt`] or [`RecordError::Decode`] with its byte offset, unless
-/// frames were read before it, in which case they are returned with the error in
-/// [`Recording::truncated`]. Never panics. The whole file is read into memory.
-pub fn read_recording(path: &Path) -> Result<Recording, RecordError> {
-    let data = std::fs::read(path).map_err(|source| RecordError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    read_recording_bytes(&data)
-}
-
-/// Like [`read_recording`], on the bytes of a recording already in memory.
-pub fn read_recording_bytes(data: &[u8]) -> Result<Recording, RecordError> {
-    let mut walk = Walk::default();
-    let stop = walk.run(data);
-    let n = walk.frames.len();
-    let truncated = match stop {
-        Ok(()) => None,
-        Err(Stop::Truncated(msg)) => Some(msg),
-        Err(Stop::Failed(e)) if n == 0 => return Err(e),
-        Err(Stop::Failed(e)) => Some(format!(
-            "{e}; reading stopped there: {n} complete frames read"
-        )),
-    };
-    let channels = walk
-        .channels
-        .into_values()
-        .map(|c| ChannelInfo {
-            schema_name: walk.schemas.get(&c.schema_id).cloned().unwrap_or_default(),
-            topic: c.topic,
-            message_encoding: c.message_encoding,
-            message_count: c.message_count,
-        })
-        .collect();
-    Ok(Recording {
-        metadata: walk.metadata,
-        frames: walk.frames,
-        summary_json: walk.summary_json,
-        channels,
-        truncated,
-        file_bytes: data.len() as u64,
-    })
-}
-
-/// Records longer than this are taken as damaged rather than cut short (bytes).
-const MAX_RECORD_LEN: u64 = 1 << 40;
-
-/// Why reading stopped before the footer.
+/// Why the scan stopped before the footer.
 enum Stop {
     /// The file ends early; the message says where.
     Truncated(String),
-    /// A damaged or undecodable record.
+    /// A damaged or undecodable record, or an I/O error.
     Failed(RecordError),
 }
 
-fn corrupt(offset: usize, detail: impl Into<String>) -> Stop {
+fn corrupt(offset: u64, detail: impl Into<String>) -> Stop {
     Stop::Failed(RecordError::Corrupt {
-        offset: offset as u64,
+        offset,
         detail: detail.into(),
     })
 }
 
-fn decode_err(detail: String) -> Stop {
-    Stop::Failed(RecordError::Decode { detail })
-}
-
-fn kind(opcode: u8) -> String {
+/// Name of an MCAP record type, for messages.
+pub(crate) fn kind(opcode: u8) -> String {
     let name = match opcode {
         op::HEADER => "header",
         op::FOOTER => "footer",
@@ -140,49 +54,84 @@ fn kind(opcode: u8) -> String {
     name.to_string()
 }
 
-struct ChannelRec {
-    topic: String,
-    schema_id: u16,
-    message_encoding: String,
-    message_count: u64,
+/// Scans the whole file; the returned layout's `end` says how it ends.
+pub(crate) fn scan<R: Read + Seek>(
+    src: &mut Source<R>,
+    path: &Path,
+    limits: &ReaderLimits,
+) -> Layout {
+    let mut scan = Scan {
+        src,
+        path,
+        limits,
+        layout: Layout::default(),
+        data_crc: crc32fast::Hasher::new(),
+    };
+    let end = match scan.run() {
+        Ok(()) => End::Complete,
+        Err(Stop::Truncated(msg)) => End::Truncated(msg),
+        Err(Stop::Failed(e)) => End::Failed(e),
+    };
+    let mut layout = scan.layout;
+    layout.end = end;
+    layout
 }
 
-#[derive(Default)]
-struct Walk {
-    frames: Vec<ParticleFrame>,
-    metadata: Option<RecordingMetadata>,
-    summary_json: Option<String>,
-    /// Schema id -> name.
-    schemas: HashMap<u16, String>,
-    channels: BTreeMap<u16, ChannelRec>,
+struct Scan<'a, R> {
+    src: &'a mut Source<R>,
+    path: &'a Path,
+    limits: &'a ReaderLimits,
+    layout: Layout,
+    /// CRC of the data section so far.
+    data_crc: crc32fast::Hasher,
 }
 
-impl Walk {
-    fn truncated(&self, len: usize, what: String) -> Stop {
+impl<R: Read + Seek> Scan<'_, R> {
+    fn truncated(&self, what: String) -> Stop {
         Stop::Truncated(format!(
-            "file ends at byte {len} {what}: {} complete frames read",
-            self.frames.len()
+            "file ends at byte {} {what}: {} complete frames read",
+            self.src.len, self.layout.state_messages
         ))
     }
 
-    fn run(&mut self, data: &[u8]) -> Result<(), Stop> {
-        let len = data.len();
+    fn io(&self, source: std::io::Error) -> Stop {
+        Stop::Failed(RecordError::Io {
+            path: self.path.to_path_buf(),
+            source,
+        })
+    }
+
+    /// Reads `n` bytes at `offset` (within the file, checked by the caller).
+    fn read(&mut self, offset: u64, n: u64) -> Result<Vec<u8>, Stop> {
+        self.src.read_at(offset, n).map_err(|e| self.io(e))
+    }
+
+    fn run(&mut self) -> Result<(), Stop> {
+        let len = self.src.len;
         let magic = mcap::MAGIC;
-        if len < magic.len() && magic.starts_with(data) {
-            return Err(self.truncated(len, "inside the 8-byte MCAP magic (no footer)".into()));
+        let mlen = magic.len() as u64;
+        let head = self.src.read_upto(0, mlen).map_err(|e| self.io(e))?;
+        if len < mlen && magic.starts_with(&head) {
+            return Err(self.truncated("inside the 8-byte MCAP magic (no footer)".into()));
         }
-        if !data.starts_with(magic) {
+        if !head.starts_with(magic) {
             return Err(Stop::Failed(RecordError::NotMcap {
                 detail: format!(
                     "the file starts with bytes [{}], expected the MCAP magic [{}]",
-                    hex_prefix(data),
+                    hex_prefix(&head),
                     hex_prefix(magic)
                 ),
             }));
         }
+        self.data_crc.update(magic);
         // A file ending in the magic was finished: a record running past its end is damage.
-        let finished = len >= 2 * magic.len() + 9 && data.ends_with(magic);
-        let mut pos = magic.len();
+        let finished = len >= 2 * mlen + 9
+            && self
+                .src
+                .read_upto(len - mlen, mlen)
+                .map_err(|e| self.io(e))?
+                == magic;
+        let mut pos = mlen;
         let mut in_summary = false;
         loop {
             let start = pos;
@@ -197,11 +146,12 @@ impl Walk {
                          (no footer)"
                     )
                 };
-                return Err(self.truncated(len, what));
+                return Err(self.truncated(what));
             }
-            let opcode = data[pos];
+            let header = self.read(pos, 9)?;
+            let opcode = header[0];
             let mut rlen = [0u8; 8];
-            rlen.copy_from_slice(&data[pos + 1..pos + 9]);
+            rlen.copy_from_slice(&header[1..9]);
             let rlen = u64::from_le_bytes(rlen);
             if opcode == 0 || (op::DATA_END < opcode && opcode < 0x80) {
                 return Err(corrupt(
@@ -212,7 +162,7 @@ impl Walk {
                     ),
                 ));
             }
-            if (start == magic.len()) != (opcode == op::HEADER) {
+            if (start == mlen) != (opcode == op::HEADER) {
                 return Err(corrupt(
                     start,
                     format!(
@@ -222,55 +172,72 @@ impl Walk {
                     ),
                 ));
             }
-            let avail = (len - pos - 9) as u64;
+            let avail = len - pos - 9;
             if rlen > avail {
-                let k = kind(opcode);
-                if opcode == op::CHUNK && rlen == u64::MAX {
-                    return Err(self.truncated(
-                        len,
-                        format!(
-                            "inside a chunk record that starts at byte {start} and was never \
-                             completed (its length is still the writer's placeholder: the \
-                             writing process stopped in the middle of a frame; no footer)"
-                        ),
+                return Err(self.overlong(start, opcode, rlen, avail, finished));
+            }
+            pos += 9 + rlen;
+            let reads_body = matches!(opcode, op::FOOTER | op::DATA_END)
+                || (!in_summary
+                    && matches!(
+                        opcode,
+                        op::CHUNK | op::SCHEMA | op::CHANNEL | op::MESSAGE | op::METADATA
                     ));
-                }
-                if finished || rlen > MAX_RECORD_LEN {
-                    return Err(corrupt(
-                        start,
-                        format!(
-                            "{k} record declares a length of {rlen} bytes but only {avail} \
-                             bytes follow; expected the record to end within the file"
-                        ),
-                    ));
-                }
-                return Err(self.truncated(
-                    len,
+            if reads_body && rlen > self.limits.max_record_bytes {
+                return Err(corrupt(
+                    start,
                     format!(
-                        "inside a {k} record that starts at byte {start} and \
-                         declares {rlen} bytes (no footer)"
+                        "{} record declares {rlen} bytes, more than the reader's limit of {} \
+                         bytes per record",
+                        kind(opcode),
+                        self.limits.max_record_bytes
                     ),
                 ));
             }
-            pos += 9 + rlen as usize;
-            let body = &data[start + 9..pos];
             match opcode {
-                op::FOOTER => return self.footer(data, start, body),
+                op::FOOTER => {
+                    let body = self.read(start + 9, rlen)?;
+                    return self.footer(start, &body);
+                }
                 op::CHUNK if in_summary => {
                     return Err(corrupt(start, "chunk record in the summary section"));
                 }
-                op::CHUNK => self.chunk(start, &data[start..pos], body)?,
+                op::CHUNK => {
+                    let record = self.read(start, 9 + rlen)?;
+                    self.data_crc.update(&record);
+                    self.chunk(start, &record[9..])?;
+                    self.layout.units.push(Unit::Chunk {
+                        offset: start,
+                        len: 9 + rlen,
+                        channels: None,
+                    });
+                }
                 _ if in_summary => {} // Summary records repeat what the data section holds.
                 op::SCHEMA | op::CHANNEL | op::MESSAGE | op::METADATA => {
+                    let record = self.read(start, 9 + rlen)?;
+                    self.data_crc.update(&record);
+                    let body = &record[9..];
+                    let result = match opcode {
+                        op::SCHEMA => self.layout.schema(body),
+                        op::CHANNEL => self.layout.channel(body),
+                        op::MESSAGE => self.layout.message(body),
+                        _ => self.layout.metadata_record(body),
+                    };
                     let at = format!("the {} record at byte {start}", kind(opcode));
-                    self.record(opcode, body)
-                        .map_err(|e| e.into_stop(start, &at))?;
+                    result.map_err(|e| Stop::Failed(e.at(start, &at)))?;
+                    if opcode == op::MESSAGE {
+                        self.layout.units.push(Unit::Message {
+                            offset: start,
+                            len: 9 + rlen,
+                        });
+                    }
                 }
                 op::DATA_END => {
-                    let saved = Cursor::new(body)
+                    let body = self.read(start + 9, rlen)?;
+                    let saved = Cursor::new(&body)
                         .u32("data section CRC")
                         .map_err(|e| corrupt(start, format!("data end record: {e}")))?;
-                    let computed = crc32(&data[..start]);
+                    let computed = self.data_crc.clone().finalize();
                     if saved != 0 && saved != computed {
                         return Err(corrupt(
                             start,
@@ -282,13 +249,45 @@ impl Walk {
                     }
                     in_summary = true;
                 }
-                _ => {} // Header, indexes, statistics, attachments, private records.
+                // Header, indexes, statistics, attachments, private records: streamed
+                // through the data CRC.
+                _ => {
+                    let mut crc = std::mem::take(&mut self.data_crc);
+                    let result = self.src.hash_range(start, pos, &mut crc);
+                    self.data_crc = crc;
+                    result.map_err(|e| self.io(e))?;
+                }
             }
         }
     }
 
+    /// The stop for a record at `start` declaring `rlen` bytes when only `avail` follow.
+    fn overlong(&self, start: u64, opcode: u8, rlen: u64, avail: u64, finished: bool) -> Stop {
+        let k = kind(opcode);
+        if opcode == op::CHUNK && rlen == u64::MAX {
+            return self.truncated(format!(
+                "inside a chunk record that starts at byte {start} and was never \
+                 completed (its length is still the writer's placeholder: the \
+                 writing process stopped in the middle of a frame; no footer)"
+            ));
+        }
+        if finished || rlen > self.limits.max_record_bytes {
+            return corrupt(
+                start,
+                format!(
+                    "{k} record declares a length of {rlen} bytes but only {avail} \
+                     bytes follow; expected the record to end within the file"
+                ),
+            );
+        }
+        self.truncated(format!(
+            "inside a {k} record that starts at byte {start} and \
+             declares {rlen} bytes (no footer)"
+        ))
+    }
+
     /// Checks the footer at `start` (body `body`), the summary CRC and the closing magic.
-    fn footer(&mut self, data: &[u8], start: usize, body: &[u8]) -> Result<(), Stop> {
+    fn footer(&mut self, start: u64, body: &[u8]) -> Result<(), Stop> {
         let mut c = Cursor::new(body);
         let parsed = (|| {
             let summary_start = c.u64("summary start")?;
@@ -301,17 +300,21 @@ impl Walk {
         let crc_end = start + 9 + 16;
         if saved != 0 {
             let from = if summary_start == 0 {
-                start as u64
+                start
             } else {
                 summary_start
             };
-            if from > start as u64 {
+            if from > start {
                 return Err(corrupt(
                     start,
                     format!("footer says the summary starts at byte {from}, after the footer"),
                 ));
             }
-            let computed = crc32(&data[from as usize..crc_end]);
+            let mut hasher = crc32fast::Hasher::new();
+            self.src
+                .hash_range(from, crc_end, &mut hasher)
+                .map_err(|e| self.io(e))?;
+            let computed = hasher.finalize();
             if computed != saved {
                 return Err(corrupt(
                     start,
@@ -322,24 +325,24 @@ impl Walk {
                 ));
             }
         }
-        let end = start + 9 + body.len();
-        let tail = &data[end..];
+        let end = start + 9 + body.len() as u64;
         let magic = mcap::MAGIC;
-        if tail.len() < magic.len() && magic.starts_with(tail) {
-            return Err(self.truncated(
-                data.len(),
-                format!(
-                    "inside the closing magic after the footer at byte {start} \
-                     (all records present)"
-                ),
-            ));
+        let tail = self
+            .src
+            .read_upto(end, magic.len() as u64)
+            .map_err(|e| self.io(e))?;
+        if tail.len() < magic.len() && magic.starts_with(&tail) {
+            return Err(self.truncated(format!(
+                "inside the closing magic after the footer at byte {start} \
+                 (all records present)"
+            )));
         }
         if !tail.starts_with(magic) {
             return Err(corrupt(
                 end,
                 format!(
                     "found bytes [{}] after the footer, expected the closing MCAP magic [{}]",
-                    hex_prefix(tail),
+                    hex_prefix(&tail),
                     hex_prefix(magic)
                 ),
             ));
@@ -347,144 +350,31 @@ impl Walk {
         Ok(())
     }
 
-    /// Decompresses the chunk record `record` (body `body`) at byte `start` and uses its records
-    /// once the whole chunk has decompressed and passed its CRC.
-    fn chunk(&mut self, start: usize, record: &[u8], body: &[u8]) -> Result<(), Stop> {
-        let limit = check_chunk_header(body).map_err(|e| corrupt(start, format!("chunk: {e}")))?;
-        let options = LinearReaderOptions::default()
-            .with_skip_start_magic(true)
-            .with_skip_end_magic(true)
-            .with_emit_chunks(false)
-            .with_validate_chunk_crcs(true)
-            .with_record_length_limit(limit);
-        let mut reader = LinearReader::new_with_options(options);
-        let mut input = record;
-        let mut records = Vec::new();
-        while let Some(event) = reader.next_event() {
-            match event {
-                Ok(LinearReadEvent::ReadRequest(need)) => {
-                    let n = need.min(input.len());
-                    reader.insert(n).copy_from_slice(&input[..n]);
-                    reader.notify_read(n);
-                    input = &input[n..];
-                }
-                Ok(LinearReadEvent::Record { opcode, data }) => {
-                    records.push((opcode, data.to_vec()))
-                }
-                Err(e) => return Err(corrupt(start, format!("chunk: {e}"))),
-            }
-        }
-        for (k, (opcode, body)) in records.iter().enumerate() {
-            let at = format!(
-                "the {} record #{k} in the chunk at byte {start}",
-                kind(*opcode)
-            );
-            self.record(*opcode, body)
-                .map_err(|e| e.into_stop(start, &at))?;
-        }
-        Ok(())
-    }
-
-    /// Handles a schema, channel, message or metadata record (others are ignored).
-    fn record(&mut self, opcode: u8, body: &[u8]) -> Result<(), RecErr> {
-        let mut c = Cursor::new(body);
-        match opcode {
-            op::SCHEMA => {
-                let id = c.u16("schema id")?;
-                let name = c.string("schema name")?;
-                c.string("schema encoding")?;
-                c.bytes_u32("schema data")?;
-                self.schemas.insert(id, name);
-            }
-            op::CHANNEL => {
-                let id = c.u16("channel id")?;
-                let schema_id = c.u16("schema id")?;
-                let topic = c.string("topic")?;
-                let message_encoding = c.string("message encoding")?;
-                c.string_map("channel metadata")?;
-                if schema_id != 0 && !self.schemas.contains_key(&schema_id) {
-                    return Err(RecErr::Corrupt(format!(
-                        "channel {topic:?} refers to schema id {schema_id}, \
-                         which no earlier schema record defines"
-                    )));
-                }
-                // A repeated definition keeps counting.
-                let message_count = self.channels.get(&id).map_or(0, |c| c.message_count);
-                self.channels.insert(
-                    id,
-                    ChannelRec {
-                        topic,
-                        schema_id,
-                        message_encoding,
-                        message_count,
-                    },
+    /// Decompresses the chunk at byte `start` (record body `body`) and uses its records once
+    /// the whole chunk has decompressed and passed its CRC.
+    fn chunk(&mut self, start: u64, body: &[u8]) -> Result<(), Stop> {
+        let data =
+            decompress(body, self.limits).map_err(|e| corrupt(start, format!("chunk: {e}")))?;
+        let records = split_records(&data).map_err(|e| corrupt(start, format!("chunk: {e}")))?;
+        let state_before = self.layout.state_messages;
+        for (k, (opcode, range)) in records.into_iter().enumerate() {
+            let body = &data[range];
+            let result = match opcode {
+                op::SCHEMA => self.layout.schema(body),
+                op::CHANNEL => self.layout.channel(body),
+                op::MESSAGE => self.layout.message(body),
+                op::METADATA => self.layout.metadata_record(body),
+                _ => Ok(()),
+            };
+            if let Err(e) = result {
+                self.layout.state_messages = state_before;
+                let at = format!(
+                    "the {} record #{k} in the chunk at byte {start}",
+                    kind(opcode)
                 );
+                return Err(Stop::Failed(e.at(start, &at)));
             }
-            op::MESSAGE => {
-                let channel_id = c.u16("channel id")?;
-                c.u32("sequence")?;
-                c.u64("log time")?;
-                c.u64("publish time")?;
-                let Some(channel) = self.channels.get_mut(&channel_id) else {
-                    return Err(RecErr::Corrupt(format!(
-                        "message on channel id {channel_id}, which no earlier channel record \
-                         defines"
-                    )));
-                };
-                channel.message_count += 1;
-                if channel.topic == STATE_TOPIC {
-                    if channel.message_encoding != "protobuf" {
-                        return Err(RecErr::Decode(format!(
-                            "{STATE_TOPIC} has message encoding {:?}, expected \"protobuf\"",
-                            channel.message_encoding
-                        )));
-                    }
-                    let frame = ParticleStateWire::decode_payload(c.rest())
-                        .and_then(ParticleStateWire::into_frame)
-                        .map_err(|e| {
-                            RecErr::Decode(format!(
-                                "{STATE_TOPIC} frame #{}: {e}",
-                                self.frames.len()
-                            ))
-                        })?;
-                    self.frames.push(frame);
-                }
-            }
-            op::METADATA => {
-                let name = c.string("metadata name")?;
-                let map = c.string_map("metadata map")?;
-                if name == METADATA_NAME {
-                    self.metadata = Some(parse_metadata(&map).map_err(RecErr::Decode)?);
-                } else if name == SUMMARY_METADATA_NAME {
-                    let summary = map.get("summary").ok_or_else(|| {
-                        RecErr::Decode(format!("metadata {name:?} lacks key \"summary\""))
-                    })?;
-                    self.summary_json = Some(summary.clone());
-                }
-            }
-            _ => {}
         }
         Ok(())
-    }
-}
-
-/// Error of one record: damage (structure) or undecodable content.
-enum RecErr {
-    Corrupt(String),
-    Decode(String),
-}
-
-impl From<String> for RecErr {
-    fn from(s: String) -> Self {
-        RecErr::Corrupt(s)
-    }
-}
-
-impl RecErr {
-    fn into_stop(self, offset: usize, at: &str) -> Stop {
-        match self {
-            RecErr::Corrupt(e) => corrupt(offset, format!("{at}: {e}")),
-            RecErr::Decode(e) => decode_err(format!("{at}: {e}")),
-        }
     }
 }
