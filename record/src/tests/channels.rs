@@ -254,3 +254,16 @@ fn record_metadata_plugins_and_extra_round_trip() {
     let parsed: RecordingMetadata = serde_json::from_str(old).unwrap();
     assert!(parsed.plugins.is_empty() && parsed.extra.is_empty());
 }
+
+/// Writes a recording with plugin channels (`/energy`: protobuf `magsep.test.Energy`; `/notes`:
+/// JSON) and a plugin metadata record for the Python check when `MAGSEP_WRITE_CUSTOM_SAMPLE`
+/// names a `.mcap` path.
+#[test]
+fn record_write_custom_channel_sample_for_python_check() {
+    let Ok(target) = std::env::var("MAGSEP_WRITE_CUSTOM_SAMPLE") else {
+        return;
+    };
+    assert!(target.ends_with(".mcap"), "{target}: expected a .mcap path");
+    write_with_channels(std::path::Path::new(&target), true);
+    eprintln!("wrote {target}");
+}
