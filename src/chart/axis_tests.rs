@@ -134,7 +134,9 @@ fn plot_axis_maps_log_and_linear() {
     let a = log(0.0, 2.0);
     let p = PlotAxis::new(&a, &axis_ticks(&a, 8, true));
     assert_eq!(p.map(&10.0, (0, 100)), 50);
-    assert_eq!(p.key_points(8usize), vec![1.0, 10.0, 100.0]);
+    let bold = p.key_points(plotters::coord::ranged1d::BoldPoints(8));
+    assert_eq!(bold, vec![1.0, 10.0, 100.0]);
+    assert_eq!(p.key_points(8usize).len(), 16, "light: 2..9 in two decades");
     let l = lin(0.0, 4.0);
     let p = PlotAxis::new(&l, &axis_ticks(&l, 5, false));
     assert_eq!(p.map(&1.0, (0, 100)), 25);
