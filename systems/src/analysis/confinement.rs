@@ -183,31 +183,21 @@ pub fn bulk_extrapolation(cylinder_diameters: &[f64], phi: &[f64]) -> Result<Lin
     fit_line(&x, phi)
 }
 
-/// Two-sided 95 % Student-t quantile t_{0.975, dof} (infinite for 0 degrees of freedom).
+/// Two-sided 95 % Student-t quantile t_{0.975, dof} (infinite for 0 degrees of freedom),
+/// exact to double precision through `statrs`' inverse CDF.
 ///
 /// ```
 /// use magsep_systems::analysis::confinement::student_t_95;
-/// assert_eq!(student_t_95(4), 2.7764);
+/// assert!((student_t_95(4) - 2.776_445_105_197_799).abs() < 1e-9);
 /// assert!((student_t_95(100_000) - 1.96).abs() < 1e-3);
 /// ```
 pub fn student_t_95(dof: usize) -> f64 {
-    const TABLE: [f64; 30] = [
-        12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622, 2.2281, 2.2010,
-        2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860, 2.0796, 2.0739,
-        2.0687, 2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423,
-    ];
-    match dof {
-        0 => f64::INFINITY,
-        1..=30 => TABLE[dof - 1],
-        _ => {
-            let z: f64 = 1.959_963_984_540_054;
-            let nu = dof as f64;
-            let (z3, z5, z7) = (z.powi(3), z.powi(5), z.powi(7));
-            let g1 = (z3 + z) / 4.0;
-            let g2 = (5.0 * z5 + 16.0 * z3 + 3.0 * z) / 96.0;
-            let g3 = (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / 384.0;
-            z + g1 / nu + g2 / (nu * nu) + g3 / (nu * nu * nu)
-        }
+    if dof == 0 {
+        return f64::INFINITY;
+    }
+    match statrs::distribution::StudentsT::new(0.0, 1.0, dof as f64) {
+        Ok(t) => statrs::distribution::ContinuousCDF::inverse_cdf(&t, 0.975),
+        Err(_) => f64::NAN,
     }
 }
 
@@ -230,7 +220,7 @@ pub struct MeanInterval {
 /// use magsep_systems::analysis::confinement::mean_interval_95;
 /// let m = mean_interval_95(&[0.60, 0.62, 0.64]).unwrap();
 /// assert!((m.mean - 0.62).abs() < 1e-15);
-/// assert!((m.half_width - 4.3027 * 0.02 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((m.half_width - 4.302_652_729_749_46 * 0.02 / 3f64.sqrt()).abs() < 1e-9);
 /// ```
 pub fn mean_interval_95(samples: &[f64]) -> Option<MeanInterval> {
     let n = samples.len();
@@ -278,6 +268,16 @@ mod tests {
         eprintln!("t quantiles: max |P - 0.95| = {max_err:.1e}");
         assert!(max_err < 1e-5, "{max_err}");
         assert!(student_t_95(0).is_infinite());
+        // Reference values t_{0.975, nu} (R: qt(0.975, nu)).
+        for (nu, t) in [
+            (1, 12.706_204_736_174_7),
+            (2, 4.302_652_729_749_46),
+            (10, 2.228_138_851_986_27),
+            (30, 2.042_272_456_301_24),
+            (120, 1.979_930_405_052_72),
+        ] {
+            assert!((student_t_95(nu) - t).abs() < 1e-8 * t, "nu = {nu}");
+        }
     }
 
     #[test]
