@@ -21,7 +21,8 @@
 //! and an adaptive run of one seed see the same Wiener increments per `dt`.
 //!
 //! The mobility's square root `B` is frozen over one `dt` (it is built once per step from the
-//! start configuration); the drift `μ F(x)` is re-evaluated at every sub-step. With hydrodynamic
+//! start configuration); the drift `μ F(x)` is re-evaluated at every sub-step (with the
+//! user's external force kernels at the sub-step's time, see [`Dynamics::at_time`]). With hydrodynamic
 //! interactions this is first order in `dt`, like the thesis's scheme.
 //!
 //! Random numbers are drawn per particle in tree order, so the result does not depend on the
