@@ -1,8 +1,8 @@
 //! Confinement measures: rescaled packing fraction and contact number, the bulk
-//! extrapolation in 1/D_cyl, and Student-t confidence intervals (thesis 000, L407, L420-439,
-//! L456, L499; spec packing.md 9.8, 9.9, 9.11).
+//! extrapolation in 1/D_cyl, and Student-t confidence intervals ([T000 §2.3-2.5],
+//! see docs/references.md).
 //!
-//! Rescalings (L420, L435) map the confined value onto [0, 1] between a reference low value
+//! Rescalings ([T000 §2.4]) map the confined value onto [0, 1] between a reference low value
 //! and the periodic (bulk) value:
 //!
 //! * cylinder: `phi* = phi / phi_periodic`;
@@ -11,14 +11,14 @@
 //! * both: `<C>* = (<C> - 2) / (<C>_periodic - 2)` (the thesis's "\[2, `<C>_periodic`\] ->
 //!   \[0, 1\]"; it can exceed 1).
 //!
-//! Bulk extrapolation (Scott & Kilgour, L439): ordinary least squares phi = a + b / D_cyl;
+//! Bulk extrapolation (Scott & Kilgour \[ScottKilgour1969\], [T000 §2.5]): ordinary least squares phi = a + b / D_cyl;
 //! the intercept a is the extrapolation to 1/D_cyl -> 0, with standard error
 //! s sqrt(1/n + xbar^2 / Sxx), s^2 = RSS / (n - 2), Sxx = sum (x - xbar)^2, x = 1/D_cyl.
 //!
-//! Confidence intervals (L407): xbar +- t_{0.975, n-1} s / sqrt(n) with the sample standard
+//! Confidence intervals ([T000 §2.3]): xbar +- t_{0.975, n-1} s / sqrt(n) with the sample standard
 //! deviation s. t is tabulated to 4 decimals for 1..=30 degrees of freedom; beyond, the
 //! Cornish-Fisher expansion t = z + g1/nu + g2/nu^2 + g3/nu^3 (z = 1.959964) is used, within
-//! 1e-4 of the exact quantile (the spec's 1.96 is its nu -> infinity limit; the expansion
+//! 1e-4 of the exact quantile (the normal quantile 1.96 is its nu -> infinity limit; the expansion
 //! removes the 4 % jump from 2.042 to 1.96 at nu = 31).
 
 /// Rescaled packing fraction in a cylinder, phi / phi_periodic.
@@ -166,7 +166,7 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> Result<LinearFit, FitError> {
 }
 
 /// Linear fit of phi against 1/D_cyl (`cylinder_diameters` in D); its `intercept` is the
-/// bulk packing fraction extrapolated to 1/D_cyl -> 0 (L439, L456).
+/// bulk packing fraction extrapolated to 1/D_cyl -> 0 ([T000 §2.5]).
 ///
 /// # Errors
 /// As [`fit_line`].
@@ -339,7 +339,7 @@ mod tests {
         assert_eq!(rescaled_packing_fraction_wedge(0.3, 0.6, 0.3), 0.0);
         assert_eq!(rescaled_packing_fraction_wedge(0.6, 0.6, 0.3), 1.0);
         assert_eq!(rescaled_contact_number(6.0, 6.0), 1.0);
-        assert!(rescaled_contact_number(7.0, 6.0) > 1.0); // may exceed 1 (L425)
+        assert!(rescaled_contact_number(7.0, 6.0) > 1.0); // may exceed 1 ([T000 §2.4])
         let m = mean_interval_95(&[1.0, 1.0, 1.0, 1.0]).unwrap();
         assert_eq!((m.mean, m.half_width, m.n), (1.0, 0.0, 4));
         assert!(mean_interval_95(&[1.0]).is_none());

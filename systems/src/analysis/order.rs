@@ -1,6 +1,6 @@
 //! Orientational order. Nematic order S (thesis 000, eq. 2.11): the largest eigenvalue of
 //! Q = (1/N) sum_i (3/2 u_i u_i^T - 1/2 I). 1 for perfect alignment, about 0.036 for 500
-//! random axes (finite-size floor, spec packing.md 9.3).
+//! random axes (finite-size floor, D-000-16).
 
 use glam::{DMat3, DVec3};
 
@@ -87,7 +87,7 @@ mod tests {
 
     #[test]
     fn random_axes_sit_at_the_finite_size_floor() {
-        // spec 9.3: <S> ~ 0.036 for N = 500 isotropic axes; check the mean over 40 sets
+        // D-000-16: <S> ~ 0.036 for N = 500 isotropic axes; check the mean over 40 sets
         let mut rng = particle_stream(5, 0);
         let mut mean = 0.0;
         for _ in 0..40 {
