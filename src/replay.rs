@@ -66,7 +66,7 @@ pub fn load_frame(
     }
     let e = frame.box_edges;
     let unbounded = e == glam::DVec3::ZERO || e == glam::DVec3::splat(f64::INFINITY);
-    if !unbounded && !(e.is_finite() && e.min_element() > 0.0) {
+    if !(unbounded || e.is_finite() && e.min_element() > 0.0) {
         return Err(bad(format!("box edges {e}")));
     }
     let status: FrameStatus =

@@ -234,9 +234,12 @@ impl Simulation {
     }
 }
 
+/// A function giving one summary key from the final world (`None`: leave the key out).
+pub type SummaryFn = fn(&World) -> Option<Value>;
+
 /// Keys plugins add to the run's summary: (key, function of the final world) (a resource).
 #[derive(Resource, Default, Clone)]
-pub struct SummaryExtras(pub Vec<(String, fn(&World) -> Option<Value>)>);
+pub struct SummaryExtras(pub Vec<(String, SummaryFn)>);
 
 /// Open the recording of `app` at `path`: metadata (scene, seed, schedule, plugins), fibres,
 /// walls, shapes, and what the pipeline adds.
