@@ -10,12 +10,12 @@ use magsep_systems::field::{
 };
 use rayon::prelude::*;
 
-/// The sources of a scene: fibres, external flux density [T], tolerance.
+/// The sources of a scene: fibres, external flux density \[T\], tolerance.
 #[derive(Debug, Clone)]
 pub struct FieldScene {
     /// Fibres.
     pub sources: Vec<CylinderSource>,
-    /// External flux density [T].
+    /// External flux density \[T\].
     pub b_ext: DVec3,
     /// Relative tolerance of each fibre's field.
     pub tolerance: f64,
@@ -32,12 +32,12 @@ impl FieldScene {
         }
     }
 
-    /// B [T] at `p` [m].
+    /// B \[T\] at `p` \[m\].
     pub fn b(&self, p: DVec3) -> DVec3 {
         total_field(&self.sources, self.b_ext, p, self.tolerance).b
     }
 
-    /// B [T] and its gradient [T/m] at `p` [m].
+    /// B \[T\] and its gradient [T/m] at `p` \[m\].
     pub fn gradient(&self, p: DVec3) -> FieldGradient {
         total_field_gradient(&self.sources, self.b_ext, p, self.tolerance)
     }
@@ -48,7 +48,7 @@ impl FieldScene {
     }
 }
 
-/// Read points from CSV text with the header `x,y,z` [m]. Blank lines are skipped.
+/// Read points from CSV text with the header `x,y,z` \[m\]. Blank lines are skipped.
 ///
 /// # Errors
 /// Every bad line, with its line number (one message per line, at most 20).
@@ -111,7 +111,7 @@ pub fn csv_header(gradient: bool) -> String {
     h
 }
 
-/// One CSV line per point: position [m], B [T] and (with `gradient`) `∂B_i/∂x_j` [T/m] in the
+/// One CSV line per point: position \[m\], B \[T\] and (with `gradient`) `∂B_i/∂x_j` [T/m] in the
 /// order `dbx_dx, dbx_dy, dbx_dz, dby_dx, ...`. Shortest round-trip formatting.
 pub fn field_rows(scene: &FieldScene, points: &[DVec3], gradient: bool) -> Vec<String> {
     points
@@ -161,7 +161,7 @@ pub fn parse_slice(s: &str) -> Result<(usize, f64), String> {
     Ok((axis, value))
 }
 
-/// `--extent A_MIN,A_MAX,B_MIN,B_MAX` [m] of the two in-plane axes.
+/// `--extent A_MIN,A_MAX,B_MIN,B_MAX` \[m\] of the two in-plane axes.
 ///
 /// # Errors
 /// A message for a malformed extent.
@@ -186,9 +186,9 @@ pub fn parse_extent(s: &str) -> Result<[f64; 4], String> {
 /// What a map shows.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MapQuantity {
-    /// |B| [T].
+    /// |B| \[T\].
     FluxDensity,
-    /// Attractive magnetic force [N] on a particle (`|F|` where `F` points towards the nearest
+    /// Attractive magnetic force \[N\] on a particle (`|F|` where `F` points towards the nearest
     /// fibre, 0 where it points away; thesis ch. 6 capture volume).
     Force(MomentModel),
 }
@@ -202,7 +202,7 @@ pub struct FieldMap {
     pub inside: Vec<Vec<bool>>,
     /// In-plane axes (indices into x, y, z).
     pub axes: (usize, usize),
-    /// Extent [min1, max1, min2, max2] [m].
+    /// Extent [min1, max1, min2, max2] \[m\].
     pub extent: [f64; 4],
 }
 

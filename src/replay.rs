@@ -103,7 +103,7 @@ pub fn last_frame(rec: &Recording) -> Result<&ParticleFrame, ReplayError> {
     })
 }
 
-/// The run's wall time [s] from the recorded summary (0 when absent).
+/// The run's wall time \[s\] from the recorded summary (0 when absent).
 pub fn recorded_wall_time(rec: &Recording) -> f64 {
     rec.summary_json
         .as_deref()

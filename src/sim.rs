@@ -1,6 +1,6 @@
 //! The simulation driver: scene -> world -> the scene's pipeline -> run, with optional
 //! recording. It knows no pipeline by name: every pipeline-specific step is a hook of the
-//! scene's [`Pipeline`](crate::scene::Pipeline).
+//! scene's [`Pipeline`].
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

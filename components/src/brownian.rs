@@ -41,7 +41,7 @@ pub enum MomentModel {
 }
 
 impl MomentModel {
-    /// `|m|` [A m²] at flux density magnitude `b` [T] and thermal energy `kt` [J].
+    /// `|m|` [A m²] at flux density magnitude `b` \[T\] and thermal energy `kt` \[J\].
     pub fn magnitude(&self, b: f64, kt: f64) -> f64 {
         match *self {
             Self::None => 0.0,
@@ -71,15 +71,15 @@ pub fn langevin(x: f64) -> f64 {
 }
 
 crate::force_contribution!(
-    /// Force of the applied field and the fibres on the particle's moment, `|m| ∇|B|` [N].
+    /// Force of the applied field and the fibres on the particle's moment, `|m| ∇|B|` \[N\].
     FieldForce
 );
 crate::force_contribution!(
-    /// Sum of dipole-dipole forces from the other particles within the cut-off [N].
+    /// Sum of dipole-dipole forces from the other particles within the cut-off \[N\].
     DipoleForce
 );
 crate::force_contribution!(
-    /// Soft-core (Mie) contact force from the other particles [N].
+    /// Soft-core (Mie) contact force from the other particles \[N\].
     ContactForce
 );
 
@@ -87,7 +87,7 @@ crate::force_contribution!(
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MagneticMoment(pub DVec3);
 
-/// Where the particle started [m] (for the mean square displacement and the Brownian criterion).
+/// Where the particle started \[m\] (for the mean square displacement and the Brownian criterion).
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct InitialPosition(pub DVec3);
 
@@ -183,7 +183,7 @@ impl Default for ContactModel {
 /// Configuration of the `brownian` pipeline (a resource).
 #[derive(Resource, Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BrownianConfig {
-    /// Temperature T [K]. Default 298.
+    /// Temperature T \[K\]. Default 298.
     pub temperature: f64,
     /// Fluid viscosity η [Pa s]. Default 1e-3.
     pub viscosity: f64,
@@ -208,7 +208,7 @@ pub struct BrownianConfig {
 }
 
 impl BrownianConfig {
-    /// Thermal energy k_B T [J].
+    /// Thermal energy k_B T \[J\].
     pub fn kt(&self) -> f64 {
         BOLTZMANN * self.temperature
     }

@@ -17,17 +17,17 @@ use serde::{Deserialize, Serialize};
 pub struct StepClock {
     /// Number of completed schedule steps.
     pub step: u64,
-    /// Time step dt [s]. Zero for pipelines without physical time (packing).
+    /// Time step dt \[s\]. Zero for pipelines without physical time (packing).
     pub dt: f64,
 }
 
 impl StepClock {
-    /// A clock at step 0 with time step `dt` [s].
+    /// A clock at step 0 with time step `dt` \[s\].
     pub fn new(dt: f64) -> Self {
         Self { step: 0, dt }
     }
 
-    /// Time of the current step, `step * dt` [s].
+    /// Time of the current step, `step * dt` \[s\].
     pub fn time(&self) -> f64 {
         self.step as f64 * self.dt
     }

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 pub enum Container {
     /// A box periodic in x, y and z, spanning `[0, edges)` on each axis.
     PeriodicBox {
-        /// Edge lengths [m].
+        /// Edge lengths \[m\].
         edges: DVec3,
     },
     /// Unbounded fluid (the Brownian pipeline around fibres): no walls, no periodicity.
@@ -26,7 +26,7 @@ pub enum Container {
     Walled {
         /// The wall geometry.
         walls: Walls,
-        /// Extent of the bounding box [m] (see [`Walls`] for what each edge means).
+        /// Extent of the bounding box \[m\] (see [`Walls`] for what each edge means).
         edges: DVec3,
     },
 }
@@ -42,7 +42,7 @@ pub enum Walls {
     /// y = x tan(angle) through the z axis (edges.y = edges.x tan(angle)); periodic in z and
     /// compressed along z only.
     Wedge {
-        /// Acute angle between the bottom and the slope [rad].
+        /// Acute angle between the bottom and the slope \[rad\].
         angle: f64,
     },
     /// Two walls z = 0 and z = edges.z; periodic in x and y; compressed along z.
@@ -73,7 +73,7 @@ impl Container {
         }
     }
 
-    /// Edge lengths of the (bounding) box [m] (zero when unbounded).
+    /// Edge lengths of the (bounding) box \[m\] (zero when unbounded).
     pub fn edges(&self) -> DVec3 {
         match self {
             Container::PeriodicBox { edges } | Container::Walled { edges, .. } => *edges,

@@ -35,18 +35,18 @@ pub struct AngularVelocity(pub DVec3);
 pub struct InertialBody {
     /// Mass density ρ_p [kg/m³].
     pub density: f64,
-    /// Volume V [m³].
+    /// Volume V \[m³\].
     pub volume: f64,
-    /// Mass m = ρ_p V [kg].
+    /// Mass m = ρ_p V \[kg\].
     pub mass: f64,
-    /// Volume-equivalent diameter d_p [m] (the sphere's diameter).
+    /// Volume-equivalent diameter d_p \[m\] (the sphere's diameter).
     pub diameter: f64,
     /// Principal moments of inertia about the body axes [kg m²].
     pub inertia: DVec3,
 }
 
 impl InertialBody {
-    /// A homogeneous sphere of `radius` [m] and `density` [kg/m³].
+    /// A homogeneous sphere of `radius` \[m\] and `density` [kg/m³].
     pub fn sphere(radius: f64, density: f64) -> Self {
         let volume = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
         let mass = density * volume;
@@ -72,35 +72,35 @@ pub struct FluidSample {
 }
 
 crate::force_contribution!(
-    /// Weight −ρ_p V g e_z [N] (F_G of eq. 2.26).
+    /// Weight −ρ_p V g e_z \[N\] (F_G of eq. 2.26).
     GravityForce
 );
 crate::force_contribution!(
-    /// Hydrostatic buoyancy ρ_f V g e_z [N] (the non-magnetic part of F_B, eq. 2.12).
+    /// Hydrostatic buoyancy ρ_f V g e_z \[N\] (the non-magnetic part of F_B, eq. 2.12).
     BuoyancyForce
 );
 crate::force_contribution!(
-    /// Magnetic buoyancy −μ₀ V M ∇H [N] of the paramagnetic liquid (eq. 2.11): the
+    /// Magnetic buoyancy −μ₀ V M ∇H \[N\] of the paramagnetic liquid (eq. 2.11): the
     /// magnetic part of F_B, pushing particles towards low field.
     MagneticBuoyancyForce
 );
 crate::force_contribution!(
     /// Force of the undisturbed flow and the fluid part of the added mass,
-    /// (ρ_f V + ½ ρ_f V) Du/Dt [N] (F_U and the Du/Dt term of F_AM, eq. 2.26).
+    /// (ρ_f V + ½ ρ_f V) Du/Dt \[N\] (F_U and the Du/Dt term of F_AM, eq. 2.26).
     UndisturbedFlowForce
 );
 crate::force_contribution!(
-    /// The explicit part of the Basset history force [N]: c_H times the history integral of
+    /// The explicit part of the Basset history force \[N\]: c_H times the history integral of
     /// all completed steps (and a step change's jump term). With the implicit integrator the
     /// newest step's part is added in `Mobility`; after the step this holds the whole force.
     HistoryForce
 );
 
-/// Steady drag (Schiller-Naumann or Stokes) F_D = k (u − v) [N] at the start-of-step
+/// Steady drag (Schiller-Naumann or Stokes) F_D = k (u − v) \[N\] at the start-of-step
 /// velocity, with its stiffness k [kg/s] so that the integrator can treat it implicitly.
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DragForce {
-    /// Force [N].
+    /// Force \[N\].
     pub force: DVec3,
     /// Stiffness k = −∂F/∂v [kg/s] (the drag's linearisation about the current slip).
     pub stiffness: f64,
@@ -140,9 +140,9 @@ impl ForceContribution for RotationalDragTorque {
 /// Equilibrium and levitation bookkeeping of a particle in a magnetised liquid.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Levitation {
-    /// Equilibrium height z_e [m] (world) where the apparent density equals ρ_p (NaN if none).
+    /// Equilibrium height z_e \[m\] (world) where the apparent density equals ρ_p (NaN if none).
     pub equilibrium_height: f64,
-    /// Last time [s] the particle was farther than the tolerance from y_e (its levitation
+    /// Last time \[s\] the particle was farther than the tolerance from y_e (its levitation
     /// time t_l once it has settled; [T002 §2.5.1.1]).
     pub last_outside: f64,
 }

@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 pub trait ForceContribution:
     Component<Mutability = bevy_ecs::component::Mutable> + Default
 {
-    /// Force on the particle [N].
+    /// Force on the particle \[N\].
     fn force(&self) -> DVec3;
     /// Torque on the particle about its centre [N m]. Default: none.
     fn torque(&self) -> DVec3 {
@@ -39,7 +39,7 @@ pub trait ForceContribution:
     fn clear(&mut self);
 }
 
-/// Sum of all registered contributions [N].
+/// Sum of all registered contributions \[N\].
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NetForce(pub DVec3);
 
@@ -47,7 +47,7 @@ pub struct NetForce(pub DVec3);
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NetTorque(pub DVec3);
 
-/// Define a force contribution component: a newtype around a force [N] implementing
+/// Define a force contribution component: a newtype around a force \[N\] implementing
 /// [`ForceContribution`] (used by the built-in contributions).
 ///
 /// ```
@@ -83,12 +83,12 @@ macro_rules! force_contribution {
 
 /// The sum of the registered external force kernels at the particle at the start of the step
 /// (a built-in contribution, written by `magsep_systems::forces::compute_kernel_forces` when a
-/// kernel is registered): force [N] and torque about the centre [N m]. Pipelines that
+/// kernel is registered): force \[N\] and torque about the centre [N m]. Pipelines that
 /// integrate with sub-steps re-evaluate the kernels themselves; this component is what the
 /// step-start `NetForce` holds.
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct KernelForce {
-    /// Force [N].
+    /// Force \[N\].
     pub force: DVec3,
     /// Torque about the centre [N m].
     pub torque: DVec3,

@@ -76,7 +76,7 @@ impl PackingConfig {
         }
     }
 
-    /// The defaults for `n` particles whose smallest diameter is `diameter` [m] (the thesis's
+    /// The defaults for `n` particles whose smallest diameter is `diameter` \[m\] (the thesis's
     /// values, with the FIRE scheme and the adaptive step rule).
     ///
     /// ```

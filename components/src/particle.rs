@@ -14,7 +14,7 @@ use crate::shape::Shape;
 )]
 pub struct ParticleId(pub u64);
 
-/// Centre of mass [m].
+/// Centre of mass \[m\].
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Position(pub DVec3);
 
@@ -50,7 +50,7 @@ pub struct ParticleRng(pub Xoshiro256PlusPlus);
 pub struct ParticleBundle {
     /// Stable identity.
     pub id: ParticleId,
-    /// Centre of mass [m].
+    /// Centre of mass \[m\].
     pub position: Position,
     /// Orientation.
     pub orientation: Orientation,
@@ -60,7 +60,7 @@ pub struct ParticleBundle {
     pub species: Species,
     /// Random stream.
     pub rng: ParticleRng,
-    /// Accumulated force [N].
+    /// Accumulated force \[N\].
     pub net_force: NetForce,
     /// Accumulated torque [N m].
     pub net_torque: NetTorque,

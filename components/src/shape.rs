@@ -10,22 +10,22 @@ use serde::{Deserialize, Serialize};
 pub enum Shape {
     /// A sphere.
     Sphere {
-        /// Radius R [m].
+        /// Radius R \[m\].
         radius: f64,
     },
     /// A cylinder of length `2 * half_length` capped by two hemispheres: all points within
     /// `radius` of the axis segment. Aspect ratio (L + D) / D = 1 + half_length / radius.
     Spherocylinder {
-        /// Radius R of the cylinder and the caps [m].
+        /// Radius R of the cylinder and the caps \[m\].
         radius: f64,
-        /// Half the length of the cylindrical part, L/2 [m].
+        /// Half the length of the cylindrical part, L/2 \[m\].
         half_length: f64,
     },
     /// A superquadric |x/a1|^g1 + |y/a2|^g2 + |z/a3|^g3 <= 1 (thesis 000, eq. 4.3). Exponents
     /// g = 2 give an ellipsoid (a spheroid when two semi-axes agree); equal semi-axes and
     /// exponents give a superball (a sphere at g = 2, a cube as g -> infinity).
     Superquadric {
-        /// Semi-axes (a1, a2, a3) along body x, y, z [m].
+        /// Semi-axes (a1, a2, a3) along body x, y, z \[m\].
         semi_axes: DVec3,
         /// Shape exponents (g1, g2, g3), each >= 2 (strictly convex), dimensionless.
         exponents: DVec3,
@@ -33,7 +33,7 @@ pub enum Shape {
 }
 
 impl Shape {
-    /// Radius R [m] (of the sphere, or of the rod's cylinder and caps); the smallest semi-axis
+    /// Radius R \[m\] (of the sphere, or of the rod's cylinder and caps); the smallest semi-axis
     /// of a superquadric.
     pub fn radius(&self) -> f64 {
         match *self {
@@ -42,7 +42,7 @@ impl Shape {
         }
     }
 
-    /// Half length of the axis segment [m]; zero for a sphere and a superquadric.
+    /// Half length of the axis segment \[m\]; zero for a sphere and a superquadric.
     pub fn half_length(&self) -> f64 {
         match *self {
             Shape::Sphere { .. } | Shape::Superquadric { .. } => 0.0,

@@ -1,4 +1,4 @@
-//! A minimal app: a `World`, the per-step [`SimSchedule`], the replay [`ObserveSchedule`], and
+//! A minimal app: a `World`, the per-step [`SimSchedule`](magsep_systems::sets::SimSchedule), the replay [`ObserveSchedule`], and
 //! the plugins that filled them. magsep does not use `bevy_app`: this trait and struct are all
 //! a simulation needs (no event loop, no runner), and they keep the dependency tree small.
 

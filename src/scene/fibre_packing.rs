@@ -30,7 +30,7 @@ use super::fibres::FibreSpec;
 pub struct FibrePackingSpec {
     /// Path of a packing recording (MCAP) whose last complete frame holds the rods.
     pub recording: String,
-    /// Translation added to every centre [m]. Default: zero.
+    /// Translation added to every centre \[m\]. Default: zero.
     #[serde(default)]
     pub offset: [f64; 3],
     /// Fixed magnetisation vector of every fibre [A/m].

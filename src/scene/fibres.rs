@@ -25,7 +25,7 @@ use super::SceneError;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExternalFieldSection {
-    /// Uniform applied flux density B_ext [T]. Default: zero.
+    /// Uniform applied flux density B_ext \[T\]. Default: zero.
     #[serde(default)]
     pub flux_density: [f64; 3],
     /// Relative accuracy asked of every fibre's field: far fibres use a multipole expansion
@@ -40,11 +40,11 @@ pub struct ExternalFieldSection {
 pub enum FibreSpec {
     /// `"cylinder"`: a uniformly magnetised finite circular cylinder.
     Cylinder {
-        /// Radius R [m]. Range: > 0.
+        /// Radius R \[m\]. Range: > 0.
         radius: f64,
-        /// Half length L [m]. Range: > 0.
+        /// Half length L \[m\]. Range: > 0.
         half_length: f64,
-        /// Centre [m]. Default: origin.
+        /// Centre \[m\]. Default: origin.
         #[serde(default)]
         center: [f64; 3],
         /// Axis direction (any length > 0).
@@ -60,7 +60,7 @@ pub enum FibreSpec {
 }
 
 impl FibreSpec {
-    /// The field source, with the magnetisation resolved against `b_ext` [T].
+    /// The field source, with the magnetisation resolved against `b_ext` \[T\].
     pub fn source(&self, b_ext: DVec3) -> CylinderSource {
         let FibreSpec::Cylinder {
             radius,
@@ -83,7 +83,7 @@ impl FibreSpec {
 }
 
 impl ExternalFieldSection {
-    /// B_ext [T].
+    /// B_ext \[T\].
     pub fn flux_density(&self) -> DVec3 {
         DVec3::from_array(self.flux_density)
     }

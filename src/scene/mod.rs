@@ -123,7 +123,7 @@ pub fn load_scene(path: &Path, registry: &Registry) -> Result<Scene, SceneErrors
 
 impl Scene {
     /// The field sources of `[[fibres]]` (magnetisation resolved against the external field),
-    /// the external flux density [T] and the field tolerance.
+    /// the external flux density \[T\] and the field tolerance.
     pub fn field_sources(&self) -> (Vec<magsep_systems::field::CylinderSource>, glam::DVec3, f64) {
         let (b_ext, tol) = self
             .external_field

@@ -135,7 +135,7 @@ pub struct RunOptions {
 pub struct RunInfo {
     /// Seed of the run.
     pub seed: u64,
-    /// Wall time of the run so far [s].
+    /// Wall time of the run so far \[s\].
     pub wall_time_s: f64,
 }
 

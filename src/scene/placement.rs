@@ -10,34 +10,34 @@ use super::FibreSpec;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum PlacementSpec {
-    /// Uniform in an axis-aligned box [m].
+    /// Uniform in an axis-aligned box \[m\].
     Box {
-        /// Lower corner [m].
+        /// Lower corner \[m\].
         min: [f64; 3],
-        /// Upper corner [m].
+        /// Upper corner \[m\].
         max: [f64; 3],
     },
     /// Above the `+axis` end face of a fibre (the thesis's TOP region).
     FibreTop {
         /// Fibre index in `[[fibres]]`.
         fibre: usize,
-        /// Distance of the nearest centres from the face [m]. Range: > particle radius.
+        /// Distance of the nearest centres from the face \[m\]. Range: > particle radius.
         gap: f64,
-        /// Height of the slab [m]. Range: > 0.
+        /// Height of the slab \[m\]. Range: > 0.
         height: f64,
     },
     /// Around the lateral surface of a fibre (the thesis's SIDE region).
     FibreSide {
         /// Fibre index in `[[fibres]]`.
         fibre: usize,
-        /// Distance of the nearest centres from the surface [m]. Range: > particle radius.
+        /// Distance of the nearest centres from the surface \[m\]. Range: > particle radius.
         gap: f64,
-        /// Thickness of the annulus [m]. Range: > 0.
+        /// Thickness of the annulus \[m\]. Range: > 0.
         thickness: f64,
     },
-    /// Explicit centres [m] (one per particle).
+    /// Explicit centres \[m\] (one per particle).
     Points {
-        /// Centres [m].
+        /// Centres \[m\].
         positions: Vec<[f64; 3]>,
     },
     /// Density-separation injection (particle_fluid; thesis 002 §2.5.3): particles denser than
@@ -45,9 +45,9 @@ pub enum PlacementSpec {
     /// fraction `impurity` of each that starts in the other band; uniform over the container's
     /// x and y, without overlap.
     Injection {
-        /// [z_min, z_max] of the heavy particles' band [m].
+        /// [z_min, z_max] of the heavy particles' band \[m\].
         heavy: [f64; 2],
-        /// [z_min, z_max] of the light particles' band [m].
+        /// [z_min, z_max] of the light particles' band \[m\].
         light: [f64; 2],
         /// Imp: fraction of each kind in the wrong band (0: pre-separated, 0.5: random).
         impurity: f64,
@@ -66,7 +66,7 @@ fn fibre_dims(fibres: &[FibreSpec], k: usize) -> Option<(f64, f64)> {
 }
 
 impl PlacementSpec {
-    /// Volume of the start region [m³] (the weight of a group in volume-weighted averages;
+    /// Volume of the start region \[m³\] (the weight of a group in volume-weighted averages;
     /// `None` for explicit points).
     pub fn volume(&self, fibres: &[FibreSpec]) -> Option<f64> {
         use std::f64::consts::PI;

@@ -22,36 +22,36 @@ pub struct SimulationSection {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ShapeSpec {
-    /// Sphere of `radius` [m].
+    /// Sphere of `radius` \[m\].
     Sphere {
-        /// Radius R [m]. Range: > 0.
+        /// Radius R \[m\]. Range: > 0.
         radius: f64,
     },
-    /// Spherocylinder: a cylinder of `cylinder_length` [m] and `radius` [m] capped by two
+    /// Spherocylinder: a cylinder of `cylinder_length` \[m\] and `radius` \[m\] capped by two
     /// hemispheres; aspect ratio (L + D) / D.
     Spherocylinder {
-        /// Radius R [m]. Range: > 0.
+        /// Radius R \[m\]. Range: > 0.
         radius: f64,
-        /// Length L of the cylindrical part [m]. Range: >= 0.
+        /// Length L of the cylindrical part \[m\]. Range: >= 0.
         cylinder_length: f64,
     },
     /// Superquadric |x/a1|^g1 + |y/a2|^g2 + |z/a3|^g3 <= 1 (thesis 000, eq. 4.3).
     Superquadric {
-        /// Semi-axes (a1, a2, a3) [m]. Range: each > 0.
+        /// Semi-axes (a1, a2, a3) \[m\]. Range: each > 0.
         semi_axes: [f64; 3],
         /// Exponents (g1, g2, g3). Range: each in [2, 20] (strictly convex).
         exponents: [f64; 3],
     },
     /// Superball |x|^g + |y|^g + |z|^g <= a^g (g = 2: sphere; g -> infinity: cube of side 2a).
     Superball {
-        /// Semi-axis a (half the side of the enclosing cube) [m]. Range: > 0.
+        /// Semi-axis a (half the side of the enclosing cube) \[m\]. Range: > 0.
         semi_axis: f64,
         /// Exponent g. Range: [2, 20].
         exponent: f64,
     },
     /// Ellipsoid (x/a1)^2 + (y/a2)^2 + (z/a3)^2 <= 1 (a spheroid when two semi-axes agree).
     Ellipsoid {
-        /// Semi-axes (a1, a2, a3) [m]. Range: each > 0.
+        /// Semi-axes (a1, a2, a3) \[m\]. Range: each > 0.
         semi_axes: [f64; 3],
     },
 }
@@ -173,7 +173,7 @@ impl Scene {
             .collect()
     }
 
-    /// The smallest particle diameter D [m] (1 if there are no particles).
+    /// The smallest particle diameter D \[m\] (1 if there are no particles).
     pub fn reference_diameter(&self) -> f64 {
         let d = self
             .particles

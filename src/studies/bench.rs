@@ -47,7 +47,7 @@ pub struct PackingRun {
     pub steps: u64,
     /// Single-particle moves (FIRE: iterations x N).
     pub attempts: u64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
     /// Pair contacts evaluated.
     pub contact_evaluations: u64,

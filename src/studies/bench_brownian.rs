@@ -29,7 +29,7 @@ pub use cost::{CostChartSizes, CostPoint, cost_points};
 pub use hi::{MobilityStepTime, random_configuration, time_mobility_step};
 pub use pipeline::{PipelineRate, free_draining_scene, mean_neighbours, pipeline_rate};
 
-/// Particle radius of every benchmark [m].
+/// Particle radius of every benchmark \[m\].
 pub const RADIUS: f64 = 75e-9;
 /// Saturated moment of the pipeline benchmark [A m²].
 pub const MOMENT: f64 = 0.87e-16;
@@ -41,7 +41,7 @@ pub const PIPELINE_VOLUME_FRACTION: f64 = 1e-3;
 pub const HI_VOLUME_FRACTION: f64 = 1e-2;
 /// Dipole cut-off of the pipeline benchmark [mean radii of a pair].
 pub const DIPOLE_CUTOFF: f64 = 30.0;
-/// Time step of the pipeline benchmark [s].
+/// Time step of the pipeline benchmark \[s\].
 pub const TIME_STEP: f64 = 1e-6;
 /// Krylov tolerance of the HI cost benchmark (the scene default).
 pub const KRYLOV_TOLERANCE: f64 = 1e-6;
@@ -84,7 +84,7 @@ pub struct BrownianBenchSizes {
     pub pipeline_n: usize,
     /// Steps before timing.
     pub warmup_steps: usize,
-    /// Wall time of stepping per measurement [s] (at least 3 steps).
+    /// Wall time of stepping per measurement \[s\] (at least 3 steps).
     pub pipeline_seconds: f64,
     /// Rayon pool sizes.
     pub threads: Vec<usize>,

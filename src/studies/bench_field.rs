@@ -106,7 +106,7 @@ pub struct FarFieldPoint {
     pub distance: f64,
     /// Median relative error of |H - H_ref| / |H_ref|.
     pub error: f64,
-    /// Cost per point [ns].
+    /// Cost per point \[ns\].
     pub ns: f64,
 }
 

@@ -15,7 +15,7 @@ pub const ASPECT_SCENE: &str = include_str!("../../scenes/brownian_aspect.toml")
 /// `scenes/brownian_concentrated.toml` (N = 500, R = 75 nm, α = 0, box above the rim).
 pub const CONCENTRATED_SCENE: &str = include_str!("../../scenes/brownian_concentrated.toml");
 
-/// Thesis table 6.1: hydrodynamic radius R_h [m] and particle moment μ_s [A m²].
+/// Thesis table 6.1: hydrodynamic radius R_h \[m\] and particle moment μ_s [A m²].
 pub const TABLE_6_1: [(f64, f64); 6] = [
     (25e-9, 0.016e-16),
     (50e-9, 0.344e-16),
@@ -25,7 +25,7 @@ pub const TABLE_6_1: [(f64, f64); 6] = [
     (212e-9, 19.35e-16),
 ];
 
-/// The table 6.1 moment [A m²] of radius `radius` [m] (`None` if it is not in the table).
+/// The table 6.1 moment [A m²] of radius `radius` \[m\] (`None` if it is not in the table).
 pub fn table_moment(radius: f64) -> Option<f64> {
     TABLE_6_1
         .iter()
@@ -36,21 +36,21 @@ pub fn table_moment(radius: f64) -> Option<f64> {
 /// What a sweep changes relative to its scene file (everything `None` keeps the file's value).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Variant {
-    /// Angle between the fibre axis (z) and the 1 T field [degrees]; the field becomes
+    /// Angle between the fibre axis (z) and the 1 T field \[degrees\]; the field becomes
     /// `[sin α, 0, cos α]`.
     pub alpha_deg: Option<f64>,
-    /// Particle radius [m] (every group), with its table 6.1 moment.
+    /// Particle radius \[m\] (every group), with its table 6.1 moment.
     pub radius: Option<f64>,
-    /// Fibre half length [m] (fibre 0).
+    /// Fibre half length \[m\] (fibre 0).
     pub half_length: Option<f64>,
 }
 
 /// Reduced run parameters (everything `None` keeps the file's value).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Reduction {
-    /// Outer time step [s].
+    /// Outer time step \[s\].
     pub time_step: Option<f64>,
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub duration: Option<f64>,
     /// Replicates.
     pub runs: Option<u64>,
@@ -257,7 +257,7 @@ pub fn curve_of(summary: &Value, group: Option<usize>) -> Vec<(f64, f64, f64, f6
         .collect()
 }
 
-/// First time [s] at which a capture curve reaches `level` (`None` if never).
+/// First time \[s\] at which a capture curve reaches `level` (`None` if never).
 pub fn time_to(curve: &[(f64, f64, f64, f64)], level: f64) -> Option<f64> {
     curve.iter().find(|p| p.1 >= level - 1e-12).map(|p| p.0)
 }

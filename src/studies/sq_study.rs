@@ -54,11 +54,11 @@ pub struct ExponentPoint {
     pub failure_rate: f64,
     /// Warm-started calls that fell back.
     pub warm_fallbacks: usize,
-    /// Mean time per cold call [ns].
+    /// Mean time per cold call \[ns\].
     pub cold_ns: f64,
-    /// Mean time per warm-started call [ns].
+    /// Mean time per warm-started call \[ns\].
     pub warm_ns: f64,
-    /// Mean time per GJK/EPA-only call (`polish = false`) [ns].
+    /// Mean time per GJK/EPA-only call (`polish = false`) \[ns\].
     pub gjk_epa_ns: f64,
     /// Mean Newton evaluations per cold call that reached Newton.
     pub cold_iterations: f64,
@@ -74,15 +74,15 @@ pub struct AccuracyPoint {
     pub method: String,
     /// Newton tolerance (None for GJK/EPA alone).
     pub tolerance: Option<f64>,
-    /// Mean time per call [ns].
+    /// Mean time per call \[ns\].
     pub cost_ns: f64,
     /// Mean |overlap - reference| [m, a = 0.5 scale].
     pub overlap_error_mean: f64,
     /// Max |overlap - reference|.
     pub overlap_error_max: f64,
-    /// Mean angle between normal and reference normal [rad].
+    /// Mean angle between normal and reference normal \[rad\].
     pub normal_error_mean: f64,
-    /// Max angle [rad].
+    /// Max angle \[rad\].
     pub normal_error_max: f64,
     /// Calls that failed (fallback, or no parry answer).
     pub failures: usize,

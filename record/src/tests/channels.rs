@@ -271,5 +271,8 @@ fn record_write_custom_channel_sample_for_python_check() {
     let rec = crate::read_recording(&target).unwrap();
     assert!(rec.truncated.is_none());
     let topics: Vec<&str> = rec.channels.iter().map(|c| c.topic.as_str()).collect();
-    assert!(topics.contains(&"/energy") && topics.contains(&"/notes"), "{topics:?}");
+    assert!(
+        topics.contains(&"/energy") && topics.contains(&"/notes"),
+        "{topics:?}"
+    );
 }

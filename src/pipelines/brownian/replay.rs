@@ -34,7 +34,7 @@ fn bad(frame: &ParticleFrame, detail: impl Into<String>) -> ReplayError {
 pub struct BrownianFrameStatus {
     /// Capture of each particle (step and fibre), `null` while free.
     pub captured: Vec<Option<CaptureEvent>>,
-    /// Start positions [m] (for displacements and the Brownian criterion).
+    /// Start positions \[m\] (for displacements and the Brownian criterion).
     pub initial_positions: Vec<[f64; 3]>,
     /// Stepper counters so far.
     pub stats: BrownianStats,

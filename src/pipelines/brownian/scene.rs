@@ -45,14 +45,14 @@ use crate::scene::{FibreSpec, PlacementSpec, SceneError};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BrownianSection {
-    /// Outer time step dt [s]. Range (0, 1].
+    /// Outer time step dt \[s\]. Range (0, 1].
     pub time_step: f64,
-    /// Simulated time [s]. Range [dt, 1e6].
+    /// Simulated time \[s\]. Range [dt, 1e6].
     pub duration: f64,
     /// Independent replicates. Default 1. Range 1..=10000.
     #[serde(default)]
     pub runs: Option<u64>,
-    /// Temperature [K]. Default 298.
+    /// Temperature \[K\]. Default 298.
     #[serde(default)]
     pub temperature: Option<f64>,
     /// Viscosity [Pa s]. Default 1e-3 (water).

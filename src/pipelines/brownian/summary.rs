@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 
 use super::stats::{Estimate, mean_interval, wilson};
 
-/// Start-region volume of each `[[particles]]` group [m³] (`None` for explicit points): the
+/// Start-region volume of each `[[particles]]` group \[m³\] (`None` for explicit points): the
 /// weights of volume-weighted averages (a resource inserted at spawn).
 #[derive(Resource, Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct StartRegions(pub Vec<Option<f64>>);
@@ -19,7 +19,7 @@ pub struct RunResult {
     pub seed: u64,
     /// Completed steps.
     pub steps: u64,
-    /// Time step [s].
+    /// Time step \[s\].
     pub dt: f64,
     /// Group (`Species`) of each particle.
     pub species: Vec<u32>,
@@ -33,8 +33,8 @@ pub struct RunResult {
 }
 
 /// The Brownian criterion of thesis eq. 6.24, per particle: free, and its squared displacement
-/// `d2` [m²] from the start after time `t` [s] below twice the free-diffusion value 2·6Dt,
-/// `D = k_B T / (6 π η a)` for radius `a` [m].
+/// `d2` \[m²\] from the start after time `t` \[s\] below twice the free-diffusion value 2·6Dt,
+/// `D = k_B T / (6 π η a)` for radius `a` \[m\].
 pub fn is_brownian(config: &BrownianConfig, a: f64, d2: f64, t: f64, captured: bool) -> bool {
     let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * a);
     !captured && d2 < 2.0 * 6.0 * d * t

@@ -32,22 +32,22 @@ pub enum ContainerSpec {
     /// A hard cylinder wall (thesis 000, ch. 2), periodic along its axis (z) and compressed
     /// along it only; its start length follows from `packing.initial_packing_fraction`.
     Cylinder {
-        /// Radius of the cylinder R_cyl = D_cyl / 2 [m], fixed. Range: > the largest
+        /// Radius of the cylinder R_cyl = D_cyl / 2 \[m\], fixed. Range: > the largest
         /// particle radius.
         radius: f64,
     },
     /// A hard wedge prism (thesis 000, ch. 2): bottom y = 0, back x = `length`, slope
     /// y = x tan(`angle`); periodic in z (its width) and compressed along it only.
     Wedge {
-        /// Acute angle alpha between bottom and slope [rad]. Range: (0, pi/2).
+        /// Acute angle alpha between bottom and slope \[rad\]. Range: (0, pi/2).
         angle: f64,
-        /// Length l_w of the wedge along x [m], fixed. Range: > 0 and room for a particle.
+        /// Length l_w of the wedge along x \[m\], fixed. Range: > 0 and room for a particle.
         length: f64,
     },
     /// Two hard walls z = 0 and z = height, periodic in x and y with the fixed side `side`;
     /// compressed along z; the start height follows from `packing.initial_packing_fraction`.
     Slab {
-        /// Periodic side along x and y [m]. Range: > 0.
+        /// Periodic side along x and y \[m\]. Range: > 0.
         side: f64,
     },
     /// A closed box of six hard walls, compressed isotropically; its start edge follows from

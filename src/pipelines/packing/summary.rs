@@ -139,7 +139,7 @@ pub struct PackingSummary {
     pub scheme: Option<OverlapRemovalScheme>,
     /// Volume step rule.
     pub volume_step_rule: Option<VolumeStepRule>,
-    /// Finest volume step reached [m³].
+    /// Finest volume step reached \[m³\].
     pub final_volume_step: Option<f64>,
     /// That step as a linear strain dV / (3 V).
     pub final_relative_strain: Option<f64>,
@@ -147,6 +147,6 @@ pub struct PackingSummary {
     pub seed: u64,
     /// Warnings (unjammed, solver fallbacks, budget).
     pub warnings: Vec<String>,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
 }

@@ -53,9 +53,9 @@ use crate::scene::{ParticleGroup, PlacementSpec, SceneError, ShapeSpec};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParticleFluidSection {
-    /// Time step Δt [s]. Range (0, 1].
+    /// Time step Δt \[s\]. Range (0, 1].
     pub time_step: f64,
-    /// Simulated time [s]. Range: 1 to 1e9 steps.
+    /// Simulated time \[s\]. Range: 1 to 1e9 steps.
     pub duration: f64,
     /// g [m/s²] along −z. Default 9.81. Range [0, 1000].
     #[serde(default)]
@@ -72,7 +72,7 @@ pub struct ParticleFluidSection {
     /// `implicit` (default) or `explicit` (the thesis's forward Euler).
     #[serde(default)]
     pub integrator: Integrator,
-    /// Levitation tolerance [m]. Default 0.5e-3 (thesis). Range > 0.
+    /// Levitation tolerance \[m\]. Default 0.5e-3 (thesis). Range > 0.
     #[serde(default)]
     pub levitation_tolerance: Option<f64>,
     /// Sample e_m every this many steps. Default steps / 200 (at least 1).
@@ -116,11 +116,11 @@ pub struct MagnetSection {
     pub kind: MagnetKind,
     /// H₀ [A/m]. Range >= 0.
     pub surface_field: f64,
-    /// Pole size p [m]. Range > 0.
+    /// Pole size p \[m\]. Range > 0.
     pub pole_size: f64,
-    /// L [m]. Range > 0.
+    /// L \[m\]. Range > 0.
     pub half_height: f64,
-    /// World z [m] of the model's y = 0. Default: the container's mid-height (0 unbounded).
+    /// World z \[m\] of the model's y = 0. Default: the container's mid-height (0 unbounded).
     #[serde(default)]
     pub mid_plane: Option<f64>,
 }
@@ -190,14 +190,14 @@ pub enum FluidContainerSpec {
     /// A channel between two walls z = 0 and z = `height`, periodic in x and y over `side`
     /// (the thesis's many-particle domain, with its y as our z).
     Channel {
-        /// Periods along x and y [m]. Range > 4 particle diameters.
+        /// Periods along x and y \[m\]. Range > 4 particle diameters.
         side: [f64; 2],
-        /// Wall distance [m]. Range > a particle diameter.
+        /// Wall distance \[m\]. Range > a particle diameter.
         height: f64,
     },
     /// A closed box [0, edges] (the experiment's tank).
     Tank {
-        /// Edges along x, y, z [m]. Range > a particle diameter.
+        /// Edges along x, y, z \[m\]. Range > a particle diameter.
         edges: [f64; 3],
     },
     /// No walls, no periodicity.
@@ -205,7 +205,7 @@ pub enum FluidContainerSpec {
 }
 
 impl FluidContainerSpec {
-    /// The box extent [m] (zero when unbounded).
+    /// The box extent \[m\] (zero when unbounded).
     pub fn edges(&self) -> DVec3 {
         match self {
             Self::Channel { side, height } => DVec3::new(side[0], side[1], *height),
@@ -214,7 +214,7 @@ impl FluidContainerSpec {
         }
     }
 
-    /// Fluid volume [m³] (infinite when unbounded).
+    /// Fluid volume \[m³\] (infinite when unbounded).
     pub fn volume(&self) -> f64 {
         match self {
             Self::Unbounded {} => f64::INFINITY,

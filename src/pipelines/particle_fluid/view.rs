@@ -45,7 +45,7 @@ pub fn density_colour(cfg: &ParticleFluidConfig, rho_p: f64) -> [f32; 4] {
     diverging((rho_p - cfg.liquid.density) / scale, 1.0)
 }
 
-/// The backdrop of a container with box `edges` [m] (zero: unbounded, drawn over ±L about
+/// The backdrop of a container with box `edges` \[m\] (zero: unbounded, drawn over ±L about
 /// the mid-plane and 0.1 m wide).
 pub fn magnet_backdrop(cfg: &ParticleFluidConfig, edges: DVec3) -> Vec<BackdropCube> {
     let half = match cfg.magnet {

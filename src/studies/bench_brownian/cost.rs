@@ -29,7 +29,7 @@ pub struct CostChartSizes {
     pub volume_fractions: Vec<f64>,
     /// Krylov tolerances.
     pub krylov_tolerances: Vec<f64>,
-    /// Time each cost measurement is repeated for, at least once [s].
+    /// Time each cost measurement is repeated for, at least once \[s\].
     pub min_time: f64,
 }
 
@@ -65,11 +65,11 @@ pub struct CostPoint {
     pub method: String,
     /// Krylov tolerance (None for the other methods).
     pub tolerance: Option<f64>,
-    /// Prepare + one noise draw [s] (mean over the repetitions).
+    /// Prepare + one noise draw \[s\] (mean over the repetitions).
     pub cost_s: f64,
     /// ‖B Bᵀ − μ‖_F / ‖μ‖_F.
     pub error: f64,
-    /// Error as drawn (at least [`ERROR_FLOOR`]).
+    /// Error as drawn (at least `ERROR_FLOOR`).
     pub plotted_error: f64,
     /// Krylov iterations of one noise draw.
     pub krylov_iterations: usize,

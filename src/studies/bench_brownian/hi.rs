@@ -46,13 +46,13 @@ pub fn normal_vectors(n: usize, seed: u64) -> Vec<DVec3> {
 /// Timing of one step's mobility work (the fastest of the repetitions).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MobilityStepTime {
-    /// `Mobility::new` [s].
+    /// `Mobility::new` \[s\].
     pub prepare_s: f64,
-    /// One `noise` [s].
+    /// One `noise` \[s\].
     pub noise_s: f64,
-    /// One `apply` [s].
+    /// One `apply` \[s\].
     pub apply_s: f64,
-    /// Sum [s].
+    /// Sum \[s\].
     pub total_s: f64,
     /// Krylov iterations of the noise draw (0 for the other methods).
     pub krylov_iterations: usize,

@@ -63,7 +63,7 @@ pub fn free_draining_scene(n: usize, adaptive: bool, seed: u64) -> String {
 pub struct PipelineRate {
     /// Timed steps.
     pub steps: u64,
-    /// Wall time of the timed steps [s].
+    /// Wall time of the timed steps \[s\].
     pub seconds: f64,
     /// Particles times steps per second of wall time.
     pub particle_steps_per_s: f64,
@@ -157,7 +157,7 @@ pub fn initial_positions(n: usize, seed: u64) -> Result<Vec<DVec3>, BenchError> 
         .clone())
 }
 
-/// Mean number of other particles within `cutoff` [m] of a particle (0 for no particles).
+/// Mean number of other particles within `cutoff` \[m\] of a particle (0 for no particles).
 pub fn mean_neighbours(x: &[DVec3], cutoff: f64) -> f64 {
     if x.is_empty() {
         return 0.0;

@@ -342,12 +342,9 @@ fn sweep_chart(
     .series(Series::new("no history", pts(none)).style(Style::Line))
     .series(Series::new("history (0.2 s window + tail)", pts(hist)).style(Style::Line))
     .series(
-        Series::new("D-002-5, no history", CHECK_NO_HISTORY.iter().copied())
-            .style(Style::Markers),
+        Series::new("D-002-5, no history", CHECK_NO_HISTORY.iter().copied()).style(Style::Markers),
     )
-    .series(
-        Series::new("D-002-5, history", CHECK_HISTORY.iter().copied()).style(Style::Markers),
-    )
+    .series(Series::new("D-002-5, history", CHECK_HISTORY.iter().copied()).style(Style::Markers))
     .line(
         vline(
             format!("d_crit = {:.2} mm (with added mass)", d_crit_xi * 1e3),

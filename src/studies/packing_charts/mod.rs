@@ -6,8 +6,8 @@
 //! in every chart's title. `--quick` runs a smoke version.
 //!
 //! Every point is the mean of independent runs (seeds 1..=runs) with a Student-t 95 % interval.
-//! Periodic reference runs of the same shapes give phi_periodic and <C>_periodic for the
-//! rescaled measures phi* and <C>* ([T000 §2.4]). Runs go in parallel over rayon;
+//! Periodic reference runs of the same shapes give phi_periodic and \<C\>_periodic for the
+//! rescaled measures phi* and \<C\>* ([T000 §2.4]). Runs go in parallel over rayon;
 //! each run is single-threaded and deterministic.
 
 mod sweeps;
@@ -43,7 +43,7 @@ pub struct RunMeasures {
     pub max_wall_penetration: f64,
     /// Contact-solver fall-backs over evaluations.
     pub fallback_rate: f64,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall_time_s: f64,
 }
 

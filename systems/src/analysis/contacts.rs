@@ -1,8 +1,8 @@
-//! Mean contact number <C> ([T000 §2.2.5, §3.3]).
+//! Mean contact number \<C\> ([T000 §2.2.5, §3.3]).
 //!
 //! Two particles touch when their surface gap is below delta. The mean per-particle count is
 //! 2 (#touching pairs) / N (erratum E-000-5: the text omits the factor 2). Because overlaps up to
-//! the tolerance survive and round-off blurs exact touching, <C>(delta) is evaluated at 16
+//! the tolerance survive and round-off blurs exact touching, \<C\>(delta) is evaluated at 16
 //! log-spaced delta in [1e-8, 1e-5] D and a least-squares straight line in delta is
 //! extrapolated to delta = 0 (Wouterse et al. 2007, as in the thesis). Gaps may be negative
 //! (tolerated overlaps) and count as contacts.
@@ -13,11 +13,11 @@ use super::super::packing::state::PackingState;
 /// Contact numbers of a packing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactNumbers {
-    /// <C> extrapolated to delta = 0.
+    /// \<C\> extrapolated to delta = 0.
     pub extrapolated: f64,
-    /// <C> at delta = 1e-4 D (the thesis's simple estimate).
+    /// \<C\> at delta = 1e-4 D (the thesis's simple estimate).
     pub at_1e_4: f64,
-    /// Sample points (delta / D, <C>(delta)) of the fit.
+    /// Sample points (delta / D, \<C\>(delta)) of the fit.
     pub samples: Vec<(f64, f64)>,
     /// Number of particles with each contact count (index = count) at delta -> 0 counted at
     /// the smallest delta.

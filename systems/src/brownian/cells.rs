@@ -70,7 +70,7 @@ impl CellList {
         [q.x.floor() as i64, q.y.floor() as i64, q.z.floor() as i64]
     }
 
-    /// Bin the particles `i` with `include(i)` into cells of edge `edge` [m] (> 0).
+    /// Bin the particles `i` with `include(i)` into cells of edge `edge` \[m\] (> 0).
     ///
     /// ```
     /// use glam::DVec3;
@@ -169,7 +169,7 @@ impl CellList {
         list
     }
 
-    /// Largest cut-off the list serves [m] (cell edge × reach).
+    /// Largest cut-off the list serves \[m\] (cell edge × reach).
     pub fn edge(&self) -> f64 {
         self.edge * self.reach as f64
     }

@@ -27,7 +27,7 @@ pub struct HydroState {
 pub struct PipelineDynamics<'a> {
     /// Force model.
     pub model: &'a ForceModel,
-    /// Radii [m].
+    /// Radii \[m\].
     pub radii: &'a [f64],
     /// Moment laws.
     pub laws: &'a [MomentModel],
@@ -37,23 +37,23 @@ pub struct PipelineDynamics<'a> {
     pub captured_interact: bool,
     /// Forces from contributions outside the model and the kernels (a user's
     /// `ForceContribution` components, accepted only with fixed steps, where no sub-step
-    /// evaluates forces), held over the step [N].
+    /// evaluates forces), held over the step \[N\].
     pub extra: &'a [DVec3],
     /// External force kernels, evaluated at every drift (None: none registered).
     pub kernels: Option<&'a ExternalForces>,
     /// `ParticleId`s and shapes (SI) that the kernels see.
     pub ids: &'a [u64],
-    /// Shapes [m].
+    /// Shapes \[m\].
     pub shapes: &'a [Shape],
-    /// Time at the start of the step [s] and the step dt [s].
+    /// Time at the start of the step \[s\] and the step dt \[s\].
     pub time: (f64, f64),
     /// Fraction of the step of the next drift evaluation.
     pub fraction: f64,
-    /// Kernel scratch (force [N], torque [N m]).
+    /// Kernel scratch (force \[N\], torque [N m]).
     pub kernel_out: Vec<(DVec3, DVec3)>,
     /// Viscosity [Pa s].
     pub viscosity: f64,
-    /// Thermal energy [J].
+    /// Thermal energy \[J\].
     pub kt: f64,
     /// Hydrodynamic interactions (None: free draining).
     pub hydro: Option<&'a HydroState>,

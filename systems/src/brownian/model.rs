@@ -25,7 +25,7 @@ use crate::field::{CylinderSource, FieldGradient, total_field, total_field_gradi
 /// Per-particle data the force model reads (all slices of length N, in `ParticleId` order).
 #[derive(Debug, Clone, Copy)]
 pub struct ParticleView<'a> {
-    /// Radii a_i [m].
+    /// Radii a_i \[m\].
     pub radii: &'a [f64],
     /// Moment laws.
     pub moments: &'a [MomentModel],
@@ -38,11 +38,11 @@ pub struct ParticleView<'a> {
 /// The three force contributions and the moments at one configuration.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ForceParts {
-    /// Field force [N].
+    /// Field force \[N\].
     pub field: Vec<DVec3>,
-    /// Dipole-dipole force [N].
+    /// Dipole-dipole force \[N\].
     pub dipole: Vec<DVec3>,
-    /// Contact force [N].
+    /// Contact force \[N\].
     pub contact: Vec<DVec3>,
     /// Moments [A m²].
     pub moments: Vec<DVec3>,
@@ -59,7 +59,7 @@ impl ForceParts {
         }
     }
 
-    /// Sum of the three forces on particle `i` [N].
+    /// Sum of the three forces on particle `i` \[N\].
     #[inline]
     pub fn total(&self, i: usize) -> DVec3 {
         self.field[i] + self.dipole[i] + self.contact[i]
@@ -80,11 +80,11 @@ pub struct PairCells {
 pub struct ForceModel {
     /// Magnetised fibres.
     pub sources: Vec<CylinderSource>,
-    /// Applied flux density [T].
+    /// Applied flux density \[T\].
     pub b_ext: glam::DVec3,
     /// Field tolerance (relative).
     pub tolerance: f64,
-    /// Thermal energy k_B T [J].
+    /// Thermal energy k_B T \[J\].
     pub kt: f64,
     /// Mie contact (None: no soft core).
     pub mie: Option<Mie>,
@@ -175,7 +175,7 @@ impl ForceModel {
         }
     }
 
-    /// Dipole-dipole forces on the mobile particles from the exerting ones [N].
+    /// Dipole-dipole forces on the mobile particles from the exerting ones \[N\].
     pub fn dipole_forces(
         &self,
         x: &[DVec3],
@@ -205,7 +205,7 @@ impl ForceModel {
         });
     }
 
-    /// Mie contact forces on the mobile particles from the exerting ones [N].
+    /// Mie contact forces on the mobile particles from the exerting ones \[N\].
     pub fn contact_forces(
         &self,
         x: &[DVec3],

@@ -10,7 +10,7 @@
 //!   `F_i = 3μ0/(4π r⁵) [(m_i·r) m_j + (m_j·r) m_i + (m_i·m_j) r − 5 (m_i·r)(m_j·r) r / r²]`.
 //!   Head to tail it is `−3 μ0 m² / (2π r⁴)` along r̂ (attractive).
 //!
-//! SI units: lengths [m], moments [A m²], energies [J], forces [N].
+//! SI units: lengths \[m\], moments [A m²], energies \[J\], forces \[N\].
 
 use glam::DVec3;
 
@@ -19,7 +19,7 @@ use crate::field::MU0;
 /// Mie(n, m) parameters with the derived constants.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mie {
-    /// Well depth ε [J].
+    /// Well depth ε \[J\].
     pub epsilon: f64,
     /// Repulsive exponent n.
     pub n: f64,
@@ -32,7 +32,7 @@ pub struct Mie {
 }
 
 impl Mie {
-    /// Mie(n, m) with well depth `epsilon` [J] (requires n > m > 0).
+    /// Mie(n, m) with well depth `epsilon` \[J\] (requires n > m > 0).
     ///
     /// ```
     /// use magsep_systems::brownian::pair::Mie;
@@ -52,7 +52,7 @@ impl Mie {
         }
     }
 
-    /// Shifted, truncated energy [J] at distance `r` for contact distance `sigma`.
+    /// Shifted, truncated energy \[J\] at distance `r` for contact distance `sigma`.
     pub fn energy_at(&self, r: f64, sigma: f64) -> f64 {
         if r >= self.min_ratio * sigma {
             return 0.0;
@@ -66,7 +66,7 @@ impl Mie {
         self.energy_at(r, 2.0)
     }
 
-    /// Force on `i` [N] for `d = x_i − x_j` and contact distance `sigma` (repulsive, along d).
+    /// Force on `i` \[N\] for `d = x_i − x_j` and contact distance `sigma` (repulsive, along d).
     #[inline]
     pub fn force(&self, d: DVec3, sigma: f64) -> DVec3 {
         let r2 = d.length_squared();
@@ -88,7 +88,7 @@ impl Mie {
         d * (mag / r)
     }
 
-    /// −dU/dr [N] at distance `r` (positive: repulsive).
+    /// −dU/dr \[N\] at distance `r` (positive: repulsive).
     pub fn radial_force(&self, r: f64, sigma: f64) -> f64 {
         self.force(DVec3::new(r, 0.0, 0.0), sigma).x
     }
@@ -106,7 +106,7 @@ impl Mie {
     }
 }
 
-/// Dipole-dipole energy [J] of moments `mi`, `mj` [A m²] at `d = x_i − x_j` [m] (eq. 6.21).
+/// Dipole-dipole energy \[J\] of moments `mi`, `mj` [A m²] at `d = x_i − x_j` \[m\] (eq. 6.21).
 ///
 /// ```
 /// use glam::DVec3;
@@ -124,7 +124,7 @@ pub fn dipole_energy(d: DVec3, mi: DVec3, mj: DVec3) -> f64 {
         * (3.0 * d.dot(mi) * d.dot(mj) / (r2 * r2 * r) - mi.dot(mj) / (r2 * r))
 }
 
-/// Dipole-dipole force on `i` [N] for `d = x_i − x_j` (eq. 6.23).
+/// Dipole-dipole force on `i` \[N\] for `d = x_i − x_j` (eq. 6.23).
 #[inline]
 pub fn dipole_force(d: DVec3, mi: DVec3, mj: DVec3) -> DVec3 {
     let r2 = d.length_squared();

@@ -36,7 +36,7 @@ use magsep_components::brownian::{BrownianStats, StepControl};
 
 /// What the stepper needs from the physics.
 pub trait Dynamics {
-    /// Radii a_i [m] (the unit of the error and displacement tests).
+    /// Radii a_i \[m\] (the unit of the error and displacement tests).
     fn radii(&self) -> &[f64];
     /// Which particles move.
     fn mobile(&self) -> &[bool];
@@ -46,7 +46,7 @@ pub trait Dynamics {
     /// The next [`Dynamics::drift`] is evaluated at fraction `t` ∈ [0, 1] of the step (for
     /// time-dependent forces). Default: ignored.
     fn at_time(&mut self, _t: f64) {}
-    /// Brownian displacements `sqrt(2 k_B T) B w` [m] for Wiener increments `w` [s^½]
+    /// Brownian displacements `sqrt(2 k_B T) B w` \[m\] for Wiener increments `w` [s^½]
     /// (zero for fixed particles). Must be linear in `w`.
     fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]);
     /// Project a trial configuration reached from `from` onto the constraints (hard cores).
@@ -76,7 +76,7 @@ pub fn wiener_increments(mobile: &[bool], h: f64, rngs: &mut [Xoshiro256PlusPlus
         .collect()
 }
 
-/// Advance `x` by one step `dt` [s]. `v0` is the drift at `x` if the caller has it (the ECS
+/// Advance `x` by one step `dt` \[s\]. `v0` is the drift at `x` if the caller has it (the ECS
 /// pipeline computes it from the accumulated forces).
 pub fn advance<D: Dynamics>(
     dynamics: &mut D,

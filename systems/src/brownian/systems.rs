@@ -33,13 +33,13 @@ use magsep_components::forces::KernelForce;
 pub struct BrownianWorkspace {
     /// Entities in `ParticleId` order.
     pub entities: Vec<Entity>,
-    /// Centres [m].
+    /// Centres \[m\].
     pub positions: Vec<DVec3>,
-    /// Radii [m].
+    /// Radii \[m\].
     pub radii: Vec<f64>,
     /// `ParticleId`s.
     pub ids: Vec<u64>,
-    /// Shapes [m] (what external force kernels see).
+    /// Shapes \[m\] (what external force kernels see).
     pub shapes: Vec<Shape>,
     /// Moment laws.
     pub laws: Vec<MomentModel>,
@@ -51,7 +51,7 @@ pub struct BrownianWorkspace {
     pub model: ForceModel,
     /// Moments at the step start [A m²].
     pub moments: Vec<DVec3>,
-    /// Field forces at the step start [N].
+    /// Field forces at the step start \[N\].
     pub field: Vec<DVec3>,
     /// Cell lists at the step start.
     pub cells: PairCells,

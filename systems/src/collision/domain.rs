@@ -20,19 +20,19 @@ use super::toi::Plane;
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PeriodicAxis {
-    /// Lower bound of the primary cell [m].
+    /// Lower bound of the primary cell \[m\].
     pub min: f64,
-    /// Period [m]. Range: > 0.
+    /// Period \[m\]. Range: > 0.
     pub length: f64,
 }
 
 impl PeriodicAxis {
-    /// Minimum image of the offset `d` [m].
+    /// Minimum image of the offset `d` \[m\].
     pub fn image(&self, d: f64) -> f64 {
         d - self.length * (d / self.length).round()
     }
 
-    /// `x` [m] wrapped into `[min, min + length)`.
+    /// `x` \[m\] wrapped into `[min, min + length)`.
     pub fn wrap(&self, x: f64) -> f64 {
         let y = self.min + (x - self.min).rem_euclid(self.length);
         // rem_euclid can round up to exactly `length`
@@ -73,7 +73,7 @@ impl CollisionDomain {
     }
 
     /// Makes axis `axis` (0 = x, 1 = y, 2 = z; larger values are ignored) periodic on
-    /// `[min, min + length)` [m].
+    /// `[min, min + length)` \[m\].
     pub fn with_periodic(mut self, axis: usize, min: f64, length: f64) -> Self {
         if let Some(slot) = self.periodic.get_mut(axis) {
             *slot = Some(PeriodicAxis { min, length });
@@ -87,7 +87,7 @@ impl CollisionDomain {
         self
     }
 
-    /// Minimum image of the offset `d` [m] along the periodic axes.
+    /// Minimum image of the offset `d` \[m\] along the periodic axes.
     pub fn minimum_image(&self, d: DVec3) -> DVec3 {
         let mut out = d;
         for (k, p) in self.periodic.iter().enumerate() {
@@ -98,7 +98,7 @@ impl CollisionDomain {
         out
     }
 
-    /// `x` [m] wrapped into the primary cell along the periodic axes.
+    /// `x` \[m\] wrapped into the primary cell along the periodic axes.
     pub fn wrap(&self, x: DVec3) -> DVec3 {
         let mut out = x;
         for (k, p) in self.periodic.iter().enumerate() {

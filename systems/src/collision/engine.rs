@@ -200,7 +200,7 @@ impl CollisionEngine {
         self.warm.clear();
     }
 
-    /// Resolves all collisions of one step of length `h` [s] and advances the positions to its end
+    /// Resolves all collisions of one step of length `h` \[s\] and advances the positions to its end
     /// (see the module header). The arrays are updated in place.
     pub fn step(
         &mut self,

@@ -82,7 +82,7 @@ pub struct RigidBody {
 }
 
 impl RigidBody {
-    /// A homogeneous solid sphere of `mass` [kg] and `radius` [m] (`I = (2/5) m r²`).
+    /// A homogeneous solid sphere of `mass` \[kg\] and `radius` \[m\] (`I = (2/5) m r²`).
     pub fn solid_sphere(mass: f64, radius: f64, velocity: DVec3, angular_velocity: DVec3) -> Self {
         Self {
             inv_mass: 1.0 / mass,
@@ -102,7 +102,7 @@ impl RigidBody {
         }
     }
 
-    /// Velocity of the material point at lever arm `r` [m] from the centre: `v + Ω×r` [m/s].
+    /// Velocity of the material point at lever arm `r` \[m\] from the centre: `v + Ω×r` [m/s].
     pub fn point_velocity(&self, r: DVec3) -> DVec3 {
         self.velocity + self.angular_velocity.cross(r)
     }

@@ -44,7 +44,7 @@ pub fn reduced_density(rho_1: f64, rho_2: f64) -> f64 {
 }
 
 /// Binary normal Stokes number `St_n = (2/9)(ρ*/ρ_f)(d u_n/ν)` [-] from the reduced density `ρ*`
-/// [kg/m³], fluid density `ρ_f` [kg/m³], diameter `d` [m], normal approach speed `u_n` [m/s] and
+/// [kg/m³], fluid density `ρ_f` [kg/m³], diameter `d` \[m\], normal approach speed `u_n` [m/s] and
 /// kinematic viscosity `ν` [m²/s].
 ///
 /// ```
@@ -63,7 +63,7 @@ pub fn binary_stokes_number(
 }
 
 /// Stokes number below which the Izard correlation gives no rebound, `−ln(2η_e/d)` [-], for the
-/// roughness `η_e` [m] and diameter `d` [m].
+/// roughness `η_e` \[m\] and diameter `d` \[m\].
 ///
 /// ```
 /// use magsep_systems::collision::restitution::izard_threshold;
@@ -74,7 +74,7 @@ pub fn izard_threshold(roughness: f64, diameter: f64) -> f64 {
 }
 
 /// Izard et al. ratio `e_eff/e_dry` (2.36) for the binary Stokes number `stokes`, roughness `η_e`
-/// [m] and diameter `d` [m]; 0 at or below [`izard_threshold`], clamped to `[0, 1]`, 0 for NaN.
+/// \[m\] and diameter `d` \[m\]; 0 at or below [`izard_threshold`], clamped to `[0, 1]`, 0 for NaN.
 ///
 /// ```
 /// use magsep_systems::collision::restitution::izard_ratio;
@@ -116,13 +116,13 @@ pub enum Restitution {
     Wet {
         /// Dry normal restitution `e_n,dry` [-]. Range: [0, 1]. Thesis: 0.85 (runs), 0.86 (fit).
         dry_normal: f64,
-        /// Effective surface roughness `η_e` [m]. Range: > 0. Thesis: 1.5e-6.
+        /// Effective surface roughness `η_e` \[m\]. Range: > 0. Thesis: 1.5e-6.
         roughness: f64,
     },
 }
 
 impl Restitution {
-    /// Normal restitution at the binary Stokes number `stokes` for the diameter `d` [m].
+    /// Normal restitution at the binary Stokes number `stokes` for the diameter `d` \[m\].
     pub fn normal(&self, stokes: f64, diameter: f64) -> f64 {
         match *self {
             Self::Dry { normal } => normal,
@@ -145,7 +145,7 @@ impl Restitution {
 pub enum Counterpart {
     /// Another particle.
     Particle {
-        /// Its diameter [m].
+        /// Its diameter \[m\].
         diameter: f64,
         /// Its density [kg/m³].
         density: f64,
@@ -299,7 +299,7 @@ impl CollisionModel {
         approach_speed < self.rest_speed
     }
 
-    /// Normal restitution of a particle (diameter [m], density [kg/m³]) hitting `other` at the
+    /// Normal restitution of a particle (diameter \[m\], density [kg/m³]) hitting `other` at the
     /// normal approach speed `approach_speed` [m/s], before the rest-speed rule.
     pub fn normal_restitution(
         &self,
@@ -333,7 +333,7 @@ impl CollisionModel {
         }
     }
 
-    /// Collision law of a particle (diameter [m], density [kg/m³]) hitting `other` at the normal
+    /// Collision law of a particle (diameter \[m\], density [kg/m³]) hitting `other` at the normal
     /// approach speed `approach_speed` [m/s], including the rest-speed rule.
     pub fn law(
         &self,

@@ -54,7 +54,7 @@ use glam::{DQuat, DVec3};
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Plane {
-    /// A point on the plane [m].
+    /// A point on the plane \[m\].
     pub point: DVec3,
     /// Unit normal pointing into the fluid (allowed) side [-].
     pub normal: DVec3,
@@ -70,7 +70,7 @@ impl Plane {
         }
     }
 
-    /// Signed distance of `x` from the plane, positive on the fluid side [m].
+    /// Signed distance of `x` from the plane, positive on the fluid side \[m\].
     pub fn signed_distance(&self, x: DVec3) -> f64 {
         self.normal.dot(x - self.point)
     }
@@ -90,19 +90,19 @@ impl Plane {
 pub struct ContactGeometry {
     /// Unit contact normal pointing from body *a* to body *b* [-].
     pub normal: DVec3,
-    /// Lever arm of *a*: from its centre to the contact point [m].
+    /// Lever arm of *a*: from its centre to the contact point \[m\].
     pub r_a: DVec3,
-    /// Lever arm of *b*: from its centre to the contact point [m].
+    /// Lever arm of *b*: from its centre to the contact point \[m\].
     pub r_b: DVec3,
-    /// Surface gap along the normal, negative when overlapping [m].
+    /// Surface gap along the normal, negative when overlapping \[m\].
     pub gap: f64,
 }
 
 /// Earliest `t ∈ [0, horizon]` at which two spheres moving with constant velocities touch while
 /// approaching.
 ///
-/// `dx = x_b − x_a` (minimum image) [m], `dv = v_b − v_a` [m/s], `sum_radii = r_a + r_b` [m],
-/// `horizon` [s]. Returns `Some(0.0)` for a touching or overlapping approaching pair and `None` for a
+/// `dx = x_b − x_a` (minimum image) \[m\], `dv = v_b − v_a` [m/s], `sum_radii = r_a + r_b` \[m\],
+/// `horizon` \[s\]. Returns `Some(0.0)` for a touching or overlapping approaching pair and `None` for a
 /// separating pair, a miss, or an impact after `horizon`. A grazing touch (zero approach speed) can
 /// be returned; filter by approach speed if needed.
 ///
@@ -131,7 +131,7 @@ pub fn sphere_sphere_toi(dx: DVec3, dv: DVec3, sum_radii: f64, horizon: f64) -> 
     (t <= horizon).then_some(t)
 }
 
-/// Earliest `t ∈ [0, horizon]` at which a sphere of radius `radius` [m] at `x` [m] moving with `v`
+/// Earliest `t ∈ [0, horizon]` at which a sphere of radius `radius` \[m\] at `x` \[m\] moving with `v`
 /// [m/s] touches `plane` while approaching it; `Some(0.0)` if it already touches or penetrates and
 /// approaches, `None` otherwise.
 ///
@@ -161,8 +161,8 @@ pub fn sphere_plane_toi(
     (t <= horizon).then_some(t)
 }
 
-/// Contact geometry of spheres *a* and *b* with centre offset `dx = x_b − x_a` (minimum image) [m]
-/// and radii [m]; coincident centres get the normal `+z` (a deterministic, arbitrary choice).
+/// Contact geometry of spheres *a* and *b* with centre offset `dx = x_b − x_a` (minimum image) \[m\]
+/// and radii \[m\]; coincident centres get the normal `+z` (a deterministic, arbitrary choice).
 pub fn sphere_sphere_contact(dx: DVec3, radius_a: f64, radius_b: f64) -> ContactGeometry {
     let dist = dx.length();
     let normal = if dist > 0.0 { dx / dist } else { DVec3::Z };
@@ -176,7 +176,7 @@ pub fn sphere_sphere_contact(dx: DVec3, radius_a: f64, radius_b: f64) -> Contact
     }
 }
 
-/// Contact geometry of a sphere (body *a*, centre `x` [m], radius [m]) and a wall (body *b*).
+/// Contact geometry of a sphere (body *a*, centre `x` \[m\], radius \[m\]) and a wall (body *b*).
 ///
 /// ```
 /// use glam::DVec3;
@@ -206,7 +206,7 @@ pub fn sphere_plane_contact(x: DVec3, radius: f64, plane: &Plane) -> ContactGeom
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ballistic {
-    /// Centre position [m].
+    /// Centre position \[m\].
     pub position: DVec3,
     /// Body-to-world rotation [-] (unused by spheres).
     pub orientation: DQuat,
@@ -217,7 +217,7 @@ pub struct Ballistic {
 }
 
 impl Ballistic {
-    /// A body at `position` [m] moving with `velocity` [m/s], identity orientation, no spin.
+    /// A body at `position` \[m\] moving with `velocity` [m/s], identity orientation, no spin.
     pub fn translating(position: DVec3, velocity: DVec3) -> Self {
         Self {
             position,
@@ -227,7 +227,7 @@ impl Ballistic {
         }
     }
 
-    /// Centre position after `t` [s] of ballistic motion [m].
+    /// Centre position after `t` \[s\] of ballistic motion \[m\].
     pub fn position_at(&self, t: f64) -> DVec3 {
         self.position + self.velocity * t
     }
@@ -250,20 +250,20 @@ impl Ballistic {
 pub enum CollisionShape {
     /// A sphere.
     Sphere {
-        /// Radius [m].
+        /// Radius \[m\].
         radius: f64,
     },
 }
 
 impl CollisionShape {
-    /// Radius of the smallest sphere about the centre that contains the shape [m].
+    /// Radius of the smallest sphere about the centre that contains the shape \[m\].
     pub fn bounding_radius(&self) -> f64 {
         match *self {
             Self::Sphere { radius } => radius,
         }
     }
 
-    /// Earliest time of impact within `[0, horizon]` [s] of this shape (state `a`) with `other`
+    /// Earliest time of impact within `[0, horizon]` \[s\] of this shape (state `a`) with `other`
     /// (state `b`); positions must already be minimum images of each other.
     pub fn time_of_impact(
         &self,
@@ -282,7 +282,7 @@ impl CollisionShape {
         }
     }
 
-    /// Earliest time of impact within `[0, horizon]` [s] of this shape (state `a`) with a wall.
+    /// Earliest time of impact within `[0, horizon]` \[s\] of this shape (state `a`) with a wall.
     pub fn time_of_impact_plane(&self, a: &Ballistic, plane: &Plane, horizon: f64) -> Option<f64> {
         match *self {
             Self::Sphere { radius } => {

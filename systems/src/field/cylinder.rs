@@ -171,7 +171,7 @@ fn g_jet<T: Real>(xi: T, radius: f64) -> [T; JET] {
 
 /// The expansion about the axis (see the module docs): with `c_n = (-1)ⁿ ψ₀⁽²ⁿ⁾/(4ⁿ n!²)`,
 /// `Ψ_zz = Σ c_n'' ρ²ⁿ`, `u = Σ 2n c_n' ρ²ⁿ⁻²`, `b = Σ 2n c_n ρ²ⁿ⁻² - χ/2`,
-/// `e = Σ 4n(n-1) c_n ρ²ⁿ⁻⁴`, each through [`AXIS_TERMS`] terms.
+/// `e = Σ 4n(n-1) c_n ρ²ⁿ⁻⁴`, each through `AXIS_TERMS` terms.
 pub fn near_axis<T: Real>(rho2: T, z: T, radius: f64, half_length: f64, chi: f64) -> HessParts<T> {
     let (xp, xm) = (z + half_length, z - half_length);
     let gp = g_jet(xp, radius);

@@ -91,8 +91,8 @@ pub fn axial_demag_factor(radius: f64, half_length: f64) -> f64 {
     2.0 / (std::f64::consts::PI * lr) * sum
 }
 
-/// Stoner-Wohlfarth magnetisation angle `θ` [rad] from the axis, for a field at angle `alpha`
-/// [rad] from the axis (folded into `[0, π/2]`), field strength `h` [A/m], saturation
+/// Stoner-Wohlfarth magnetisation angle `θ` \[rad\] from the axis, for a field at angle `alpha`
+/// \[rad\] from the axis (folded into `[0, π/2]`), field strength `h` [A/m], saturation
 /// magnetisation `ms` [A/m] and demagnetising factors `nz`, `nx`.
 pub fn stoner_wohlfarth_angle(alpha: f64, h: f64, ms: f64, nz: f64, nx: f64) -> f64 {
     let e = |t: f64| {
@@ -128,7 +128,7 @@ pub fn stoner_wohlfarth_angle(alpha: f64, h: f64, ms: f64, nz: f64, nx: f64) -> 
 }
 
 /// Magnetisation [A/m] of a saturated cylinder (axis `axis`, saturation `ms` [A/m]) in the
-/// external flux density `b_ext` [T], by Stoner-Wohlfarth with the cylinder's demagnetising
+/// external flux density `b_ext` \[T\], by Stoner-Wohlfarth with the cylinder's demagnetising
 /// factors. Zero field gives zero magnetisation (no remanent state is assumed).
 pub fn stoner_wohlfarth_magnetisation(
     axis: DVec3,

@@ -11,7 +11,7 @@ use super::source::FieldGradient;
 
 pub use magsep_components::brownian::{BOLTZMANN as K_B, MomentModel, langevin};
 
-/// Force [N] on a dipole with moment law `law` (thermal energy `kt` [J], used by the Langevin
+/// Force \[N\] on a dipole with moment law `law` (thermal energy `kt` \[J\], used by the Langevin
 /// law) in a field with gradient `g`.
 ///
 /// ```

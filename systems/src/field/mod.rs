@@ -10,7 +10,7 @@
 //! * [`demag`]: demagnetising factors and Stoner-Wohlfarth.
 //! * [`real`]: `f64` or [`Dual3`] numbers (exact gradients by forward-mode differentiation).
 //!
-//! SI units: lengths [m], magnetisation and H [A/m], B [T], gradients [T/m], forces [N].
+//! SI units: lengths \[m\], magnetisation and H [A/m], B \[T\], gradients [T/m], forces \[N\].
 //!
 //! ```
 //! use glam::DVec3;

@@ -23,35 +23,35 @@ pub const EXACT: f64 = 1e-15;
 /// A uniformly magnetised finite circular cylinder in the world frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CylinderSource {
-    /// Centre [m].
+    /// Centre \[m\].
     pub center: DVec3,
     /// Body frame: columns are `e1`, `e2`, `e3 = axis` (unit).
     frame: DMat3,
-    /// Radius R [m].
+    /// Radius R \[m\].
     pub radius: f64,
-    /// Half length L [m] (the thesis's ch. 5 `L`).
+    /// Half length L \[m\] (the thesis's ch. 5 `L`).
     pub half_length: f64,
     /// Magnetisation [A/m], world frame.
     pub magnetisation: DVec3,
     m_body: [f64; 3],
     q: Vec<f64>,
-    /// Circumscribed radius `√(L² + R²)` [m].
+    /// Circumscribed radius `√(L² + R²)` \[m\].
     pub circumradius: f64,
 }
 
-/// Field at a point: `H` [A/m] and `B` [T] of one source (or a sum).
+/// Field at a point: `H` [A/m] and `B` \[T\] of one source (or a sum).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FieldValue {
     /// Magnetic field strength H [A/m].
     pub h: DVec3,
-    /// Flux density B [T] (`μ0 (H + M)` inside a source, `μ0 H` outside).
+    /// Flux density B \[T\] (`μ0 (H + M)` inside a source, `μ0 H` outside).
     pub b: DVec3,
 }
 
 /// Field and gradient: `grad_b.col(j) = ∂B/∂x_j` [T/m].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FieldGradient {
-    /// Flux density B [T].
+    /// Flux density B \[T\].
     pub b: DVec3,
     /// Jacobian of B: column `j` is `∂B/∂x_j` [T/m] (symmetric outside all sources).
     pub grad_b: DMat3,
@@ -59,7 +59,7 @@ pub struct FieldGradient {
 
 impl CylinderSource {
     /// A cylinder centred at `center` with axis direction `axis` (normalised here), radius and
-    /// half length [m], and magnetisation [A/m]. Inputs must be finite with `radius > 0`,
+    /// half length \[m\], and magnetisation [A/m]. Inputs must be finite with `radius > 0`,
     /// `half_length > 0` and `axis != 0` (scene validation checks this).
     pub fn new(
         center: DVec3,
@@ -134,7 +134,7 @@ impl CylinderSource {
         }
     }
 
-    /// `H` [A/m] and `B` [T] at `p` [m] to relative tolerance `tol` ([`EXACT`] for full
+    /// `H` [A/m] and `B` \[T\] at `p` \[m\] to relative tolerance `tol` ([`EXACT`] for full
     /// precision).
     pub fn field(&self, p: DVec3, tol: f64) -> FieldValue {
         self.field_with(p, self.multipole_order(p, tol))
@@ -152,7 +152,7 @@ impl CylinderSource {
         }
     }
 
-    /// `B` [T] and its exact gradient [T/m] at `p` (forward-mode differentiation through the
+    /// `B` \[T\] and its exact gradient [T/m] at `p` (forward-mode differentiation through the
     /// same kernel).
     pub fn field_gradient(&self, p: DVec3, tol: f64) -> FieldGradient {
         let order = self.multipole_order(p, tol);
@@ -206,13 +206,13 @@ impl CylinderSource {
         self.center + axis * z.clamp(-self.half_length, self.half_length) + radial
     }
 
-    /// Distance [m] from `p` to the solid cylinder (0 inside).
+    /// Distance \[m\] from `p` to the solid cylinder (0 inside).
     pub fn distance(&self, p: DVec3) -> f64 {
         (p - self.closest_point(p)).length()
     }
 }
 
-/// Sum of the fields of `sources` plus a uniform external flux density `b_ext` [T].
+/// Sum of the fields of `sources` plus a uniform external flux density `b_ext` \[T\].
 pub fn total_field(sources: &[CylinderSource], b_ext: DVec3, p: DVec3, tol: f64) -> FieldValue {
     let mut out = FieldValue {
         h: b_ext / MU0,
@@ -226,7 +226,7 @@ pub fn total_field(sources: &[CylinderSource], b_ext: DVec3, p: DVec3, tol: f64)
     out
 }
 
-/// Sum of the fields and gradients of `sources` plus a uniform `b_ext` [T].
+/// Sum of the fields and gradients of `sources` plus a uniform `b_ext` \[T\].
 pub fn total_field_gradient(
     sources: &[CylinderSource],
     b_ext: DVec3,

@@ -63,7 +63,7 @@ pub enum HistoryChoice {
     /// Window of `window` seconds with exact weights plus the ten-exponential tail of van
     /// Hinsberg et al. (O(1) per step); `tail = false` truncates the memory at the window.
     Window {
-        /// t_win [s]. Range: >= the time step. Default 0.2 s (the thesis's fig. 2.10 runs).
+        /// t_win \[s\]. Range: >= the time step. Default 0.2 s (the thesis's fig. 2.10 runs).
         window: f64,
         /// Keep the exponential tail. Default true.
         #[serde(default = "yes")]
@@ -101,14 +101,14 @@ pub enum Integrator {
 /// The particle-fluid pipeline's configuration.
 #[derive(Resource, Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParticleFluidConfig {
-    /// Time step Δt [s].
+    /// Time step Δt \[s\].
     pub dt: f64,
     /// Number of steps of the run.
     pub steps: u64,
     /// Gravitational acceleration g [m/s²], acting along −z (magsep's vertical; the thesis's
     /// y).
     pub gravity: f64,
-    /// World height z [m] of the magnet model's y = 0 (the mid-plane between the faces at
+    /// World height z \[m\] of the magnet model's y = 0 (the mid-plane between the faces at
     /// y = ±L): the thesis's y is z − `mid_plane`.
     pub mid_plane: f64,
     /// The liquid.
@@ -125,19 +125,19 @@ pub struct ParticleFluidConfig {
     pub history: HistoryChoice,
     /// Velocity update.
     pub integrator: Integrator,
-    /// Levitation tolerance [m] (|y − y_e| within it counts as levitated; thesis 0.5 mm).
+    /// Levitation tolerance \[m\] (|y − y_e| within it counts as levitated; thesis 0.5 mm).
     pub levitation_tolerance: f64,
     /// Sample the separation error every this many steps.
     pub observe_every: u64,
 }
 
 impl ParticleFluidConfig {
-    /// The magnet model's height y of world height `z` [m].
+    /// The magnet model's height y of world height `z` \[m\].
     pub fn magnet_y(&self, z: f64) -> f64 {
         z - self.mid_plane
     }
 
-    /// Equilibrium height (world z) [m] of a particle of `density` [kg/m³], if it levitates.
+    /// Equilibrium height (world z) \[m\] of a particle of `density` [kg/m³], if it levitates.
     pub fn equilibrium_height(&self, density: f64) -> Option<f64> {
         self.magnet
             .equilibrium_height(&self.liquid, self.gravity, density)

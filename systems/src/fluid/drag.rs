@@ -30,8 +30,8 @@ pub enum DragLaw {
     Stokes,
 }
 
-/// Drag on a sphere of diameter `d` [m] with slip `slip = u − v` [m/s] in a liquid of
-/// `density` [kg/m³] and `viscosity` [Pa s]: (force [N], secant stiffness [kg/s], Re).
+/// Drag on a sphere of diameter `d` \[m\] with slip `slip = u − v` [m/s] in a liquid of
+/// `density` [kg/m³] and `viscosity` [Pa s]: (force \[N\], secant stiffness [kg/s], Re).
 ///
 /// ```
 /// use glam::DVec3;
@@ -66,7 +66,7 @@ pub fn rotational_drag_coefficient(re_r: f64) -> f64 {
     }
 }
 
-/// Torque on a sphere of diameter `d` [m] with `delta = ½ω − Ω` [rad/s]: (torque [N m],
+/// Torque on a sphere of diameter `d` \[m\] with `delta = ½ω − Ω` [rad/s]: (torque [N m],
 /// secant stiffness [kg m²/s], Re_r).
 ///
 /// ```

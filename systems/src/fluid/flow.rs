@@ -32,13 +32,13 @@ pub enum FlowModel {
     Oscillating {
         /// Velocity amplitude [m/s].
         amplitude: [f64; 3],
-        /// Frequency f [Hz]. Range: > 0.
+        /// Frequency f \[Hz\]. Range: > 0.
         frequency: f64,
     },
 }
 
 impl FlowModel {
-    /// u, Du/Dt and ω at `x` [m] and time `t` [s].
+    /// u, Du/Dt and ω at `x` \[m\] and time `t` \[s\].
     ///
     /// ```
     /// use glam::DVec3;

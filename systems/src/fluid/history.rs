@@ -137,7 +137,7 @@ pub struct HistoryState {
 }
 
 impl HistoryState {
-    /// History starting at `t0` [s] with slip `initial_slip` [m/s]: a step change
+    /// History starting at `t0` \[s\] with slip `initial_slip` [m/s]: a step change
     /// `J = initial_slip` at `t_s = t0` (eq. 2.27; a zero slip gives no jump term).
     ///
     /// ```
@@ -159,7 +159,7 @@ impl HistoryState {
         }
     }
 
-    /// Time of the last slip sample, `t_origin + n Δt` [s].
+    /// Time of the last slip sample, `t_origin + n Δt` \[s\].
     ///
     /// ```
     /// use glam::DVec3;
@@ -211,7 +211,7 @@ impl HistoryState {
         self.increments.len()
     }
 
-    /// Jump term `J_s/√(t − t_s)` [m s^{−3/2}] at time `t` [s]; defined as zero for
+    /// Jump term `J_s/√(t − t_s)` [m s^{−3/2}] at time `t` \[s\]; defined as zero for
     /// `t ≤ t_s` (it is singular but integrable at `t = t_s`).
     ///
     /// ```
@@ -283,7 +283,7 @@ impl HistoryState {
     }
 
     /// `I(t_n)` [m s^{−3/2}] at the last sample `t_n` from the completed intervals (the newest
-    /// gets `c_0`), plus the tail and the jump term at `t_n` (`t_n` [s] is normally
+    /// gets `c_0`), plus the tail and the jump term at `t_n` (`t_n` \[s\] is normally
     /// [`HistoryState::time`]; only the jump term uses it, and it is zero at `t_n = t_s`).
     /// The explicit scheme's force is `F_H(t_n) = c_H · current_integral`.
     ///
@@ -302,7 +302,7 @@ impl HistoryState {
     /// `I(t_{n+1})` [m s^{−3/2}] minus the newest interval's term `c_0 Δw_n`: the completed
     /// intervals as seen from `t_{n+1} = t_n + Δt` (lags shifted by one, the newest completed
     /// interval gets `c_1`; for a full window its oldest interval enters the tail exactly as
-    /// [`HistoryState::push`] will move it), plus the tail and the jump term at `t_next` [s].
+    /// [`HistoryState::push`] will move it), plus the tail and the jump term at `t_next` \[s\].
     /// The implicit scheme's force is
     /// `F_H(t_{n+1}) = c_H (past_integral + c_0 (w_{n+1} − w_n))`.
     ///
@@ -374,9 +374,9 @@ impl HistoryState {
         self.steps += 1;
     }
 
-    /// A collision at `t_c` [s] during the current step: discards all history (buffer and
+    /// A collision at `t_c` \[s\] during the current step: discards all history (buffer and
     /// tail, eq. 2.29), records the step change `jump = w(t_c⁺) − w(t_c⁻) = v(t_c⁻) − v(t_c⁺)`
-    /// [m/s] at `t_c`, and restarts the buffer at the step boundary `t_next_sample ≥ t_c` [s]
+    /// [m/s] at `t_c`, and restarts the buffer at the step boundary `t_next_sample ≥ t_c` \[s\]
     /// with the post-collision slip `slip_after` [m/s] as its first sample (the slip is taken
     /// constant on `[t_c, t_next_sample]`). The next evaluation, at `t_next_sample + Δt > t_c`,
     /// has a finite jump term `J/√(t − t_c)` that uses the true `t_c`.

@@ -25,9 +25,9 @@ pub const TAIL_AMPLITUDES: [f64; TAIL_TERMS] = [
 pub const MAX_WINDOW_STEPS: usize = 1 << 24;
 
 /// Basset coefficient `c_H = (3/2) d_p² √(π ρ_f μ)` [kg s^{−1/2}], so that the history force is
-/// `F_H = c_H · I` [N] with `I` [m s^{−3/2}].
+/// `F_H = c_H · I` \[N\] with `I` [m s^{−3/2}].
 ///
-/// `diameter` `d_p` [m], `fluid_density` `ρ_f` [kg/m³], `viscosity` (dynamic) `μ` [Pa s].
+/// `diameter` `d_p` \[m\], `fluid_density` `ρ_f` [kg/m³], `viscosity` (dynamic) `μ` [Pa s].
 ///
 /// ```
 /// use magsep_systems::fluid::history::basset_coefficient;
@@ -39,8 +39,8 @@ pub fn basset_coefficient(diameter: f64, fluid_density: f64, viscosity: f64) -> 
 }
 
 /// The ten-exponential approximation of `s^{−1/2}` [s^{−1/2}] for a window of duration
-/// `window_duration = t_win` [s]: `Σ a_i √(e/t_i) exp(−s/(2t_i))`, `t_i = t̃_i t_win`. Meant for
-/// `s ≥ t_win` (lag `s` [s]).
+/// `window_duration = t_win` \[s\]: `Σ a_i √(e/t_i) exp(−s/(2t_i))`, `t_i = t̃_i t_win`. Meant for
+/// `s ≥ t_win` (lag `s` \[s\]).
 ///
 /// ```
 /// use magsep_systems::fluid::history::tail_kernel;
@@ -81,7 +81,7 @@ pub enum HistoryKernel {
 }
 
 impl HistoryKernel {
-    /// A window of duration `window_duration` [s] at step `dt` [s]: `N_w = max(1,
+    /// A window of duration `window_duration` \[s\] at step `dt` \[s\]: `N_w = max(1,
     /// round(window_duration/dt))` (a non-finite ratio gives `N_w = 0`, which
     /// [`HistoryPlan::new`] rejects).
     ///
@@ -151,7 +151,7 @@ pub(super) fn lag_weight(inv_sqrt_dt: f64, j: usize) -> f64 {
 }
 
 impl HistoryPlan {
-    /// Plan for step `dt` [s] and `kernel`. Errors: `dt` not positive and finite, or a window
+    /// Plan for step `dt` \[s\] and `kernel`. Errors: `dt` not positive and finite, or a window
     /// with 0 or more than [`MAX_WINDOW_STEPS`] steps.
     ///
     /// ```
@@ -194,7 +194,7 @@ impl HistoryPlan {
         })
     }
 
-    /// The step `Δt` [s].
+    /// The step `Δt` \[s\].
     ///
     /// ```
     /// use magsep_systems::fluid::history::{HistoryKernel, HistoryPlan};
@@ -214,7 +214,7 @@ impl HistoryPlan {
         self.kernel
     }
 
-    /// Window duration `t_win = N_w Δt` [s] (`None` for [`HistoryKernel::Full`]).
+    /// Window duration `t_win = N_w Δt` \[s\] (`None` for [`HistoryKernel::Full`]).
     ///
     /// ```
     /// use magsep_systems::fluid::history::{HistoryKernel, HistoryPlan};

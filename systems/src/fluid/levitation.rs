@@ -27,9 +27,9 @@ pub enum Approach {
 /// The linearised levitation of a sphere about its equilibrium height.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearLevitation {
-    /// Equilibrium height y_e [m].
+    /// Equilibrium height y_e \[m\].
     pub equilibrium_height: f64,
-    /// Effective mass [kg].
+    /// Effective mass \[kg\].
     pub mass: f64,
     /// Stokes damping k = 3πμd [kg/s].
     pub damping: f64,
@@ -38,7 +38,7 @@ pub struct LinearLevitation {
 }
 
 impl LinearLevitation {
-    /// Linearise for a sphere of `diameter` [m] and `density` [kg/m³]; `None` without an
+    /// Linearise for a sphere of `diameter` \[m\] and `density` [kg/m³]; `None` without an
     /// equilibrium in range or a non-restoring gradient.
     ///
     /// ```
@@ -103,7 +103,7 @@ fn mass_density(liquid: &Liquid, density: f64, added_mass: bool) -> f64 {
     }
 }
 
-/// Critical diameter [m] between monotone and oscillating approach for particles of
+/// Critical diameter \[m\] between monotone and oscillating approach for particles of
 /// `density` (`added_mass = false`: the thesis's 3.2 mm criterion). `None` without an
 /// equilibrium.
 ///
@@ -130,8 +130,8 @@ pub fn critical_diameter(
     (d4.is_finite() && d4 > 0.0).then(|| d4.powf(0.25))
 }
 
-/// Levitation time [s] from a sampled trajectory: the last time the particle is farther than
-/// `tolerance` [m] from `equilibrium` (linear interpolation of the crossing). Zero if it never
+/// Levitation time \[s\] from a sampled trajectory: the last time the particle is farther than
+/// `tolerance` \[m\] from `equilibrium` (linear interpolation of the crossing). Zero if it never
 /// leaves the band; the last sample time if it never enters it for good (not settled).
 ///
 /// ```

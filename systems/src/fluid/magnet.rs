@@ -68,27 +68,27 @@ pub enum MagnetModel {
     Bottom {
         /// Field strength at the face H₀ [A/m]. Range: >= 0.
         surface_field: f64,
-        /// Pole size p (half the magnetisation wavelength) [m]. Range: > 0.
+        /// Pole size p (half the magnetisation wavelength) \[m\]. Range: > 0.
         pole_size: f64,
-        /// L [m]: the face is at y = −L. Range: > 0.
+        /// L \[m\]: the face is at y = −L. Range: > 0.
         half_height: f64,
     },
     /// A magnet above the liquid, strong face at y = +L (eq. 2.7): light particles levitate.
     Top {
         /// Field strength at the face H₀ [A/m]. Range: >= 0.
         surface_field: f64,
-        /// Pole size p [m]. Range: > 0.
+        /// Pole size p \[m\]. Range: > 0.
         pole_size: f64,
-        /// L [m]: the face is at y = +L. Range: > 0.
+        /// L \[m\]: the face is at y = +L. Range: > 0.
         half_height: f64,
     },
     /// Two facing magnets, faces at y = ±L (eq. 2.8, magnitudes superposed).
     Two {
         /// Field strength at each face from its own magnet H₀ [A/m]. Range: >= 0.
         surface_field: f64,
-        /// Pole size p [m]. Range: > 0.
+        /// Pole size p \[m\]. Range: > 0.
         pole_size: f64,
-        /// L [m]: the faces are at y = ±L. Range: > 0.
+        /// L \[m\]: the faces are at y = ±L. Range: > 0.
         half_height: f64,
     },
 }
@@ -115,7 +115,7 @@ impl MagnetModel {
         }
     }
 
-    /// The interval of y where the model holds [m] (outside it the magnet body is).
+    /// The interval of y where the model holds \[m\] (outside it the magnet body is).
     pub fn valid_range(&self) -> (f64, f64) {
         match *self {
             Self::None => (f64::NEG_INFINITY, f64::INFINITY),
@@ -193,7 +193,7 @@ impl MagnetModel {
         -c * d_hh
     }
 
-    /// Magnetic buoyancy force on a body of `volume` [m³] at height y: −μ₀ V χ H dH/dy [N]
+    /// Magnetic buoyancy force on a body of `volume` \[m³\] at height y: −μ₀ V χ H dH/dy \[N\]
     /// along y.
     pub fn magnetic_buoyancy(&self, susceptibility: f64, volume: f64, y: f64) -> f64 {
         -volume * self.kelvin_density(susceptibility, y)
@@ -224,7 +224,7 @@ impl MagnetModel {
         }
     }
 
-    /// Equilibrium height y_e [m] of a particle of density `particle_density` [kg/m³] from the
+    /// Equilibrium height y_e \[m\] of a particle of density `particle_density` [kg/m³] from the
     /// closed forms (derived from eq. 2.17-2.19; the printed table 2.2 is wrong, erratum E-002-5).
     /// `None` when the particle does not levitate in the valid range.
     ///
@@ -257,7 +257,7 @@ impl MagnetModel {
         (y.is_finite() && y >= lo && y <= hi).then_some(y)
     }
 
-    /// Equilibrium height [m] by root finding on ρ_{f,a}(y) − ρ_p over the valid range
+    /// Equilibrium height \[m\] by root finding on ρ_{f,a}(y) − ρ_p over the valid range
     /// (bisection to 1e-14 relative; independent of the closed forms). `None` if there is no
     /// sign change (no levitation in range). For unbounded ranges the search extends 50 pole
     /// sizes from the face.

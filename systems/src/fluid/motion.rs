@@ -23,7 +23,7 @@
 
 use glam::{DQuat, DVec3};
 
-/// Effective translational mass [kg]: m, plus ½ρ_f V with added mass.
+/// Effective translational mass \[kg\]: m, plus ½ρ_f V with added mass.
 pub fn effective_mass(mass: f64, volume: f64, fluid_density: f64, added_mass: bool) -> f64 {
     if added_mass {
         mass + 0.5 * fluid_density * volume
@@ -46,7 +46,7 @@ pub fn velocity_step(v: DVec3, force: DVec3, mass: f64, stiffness: f64, dt: f64)
     v + force * (dt / (mass + stiffness * dt))
 }
 
-/// Rotate orientation `q` by angular velocity `omega` [rad/s] over `dt` [s] (exact for
+/// Rotate orientation `q` by angular velocity `omega` [rad/s] over `dt` \[s\] (exact for
 /// constant Ω), renormalised.
 pub fn rotate(q: DQuat, omega: DVec3, dt: f64) -> DQuat {
     let angle = omega.length() * dt;

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::config::ParticleFluidConfig;
 
-/// e_m of `heights` against `equilibria` [m], divided by `scale` L [m]; particles without an
+/// e_m of `heights` against `equilibria` \[m\], divided by `scale` L \[m\]; particles without an
 /// equilibrium (NaN) are left out. NaN when none is left.
 ///
 /// ```
@@ -35,7 +35,7 @@ pub fn separation_error(heights: &[f64], equilibria: &[f64], scale: f64) -> f64 
 /// Separation error against time, overall and per density group.
 #[derive(Resource, Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SeparationCurve {
-    /// Sample times [s].
+    /// Sample times \[s\].
     pub times: Vec<f64>,
     /// e_m over all levitating particles.
     pub total: Vec<f64>,

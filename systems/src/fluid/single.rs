@@ -25,7 +25,7 @@ pub struct SphereInLiquid {
     pub magnet: MagnetModel,
     /// g [m/s²].
     pub gravity: f64,
-    /// Sphere diameter d_p [m].
+    /// Sphere diameter d_p \[m\].
     pub diameter: f64,
     /// Sphere density ρ_p [kg/m³].
     pub density: f64,
@@ -42,13 +42,13 @@ pub struct SphereInLiquid {
 /// A sampled trajectory.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Trajectory {
-    /// Sample times [s].
+    /// Sample times \[s\].
     pub times: Vec<f64>,
-    /// Heights y [m].
+    /// Heights y \[m\].
     pub heights: Vec<f64>,
     /// Velocities v_y [m/s].
     pub velocities: Vec<f64>,
-    /// History force F_H,y [N] at the sample times.
+    /// History force F_H,y \[N\] at the sample times.
     pub history_force: Vec<f64>,
     /// Largest translational Reynolds number.
     pub max_reynolds: f64,
@@ -84,7 +84,7 @@ impl SphereInLiquid {
         }
     }
 
-    /// A sphere of `radius` [m] and `density` [kg/m³] released in quiescent MnCl₂(aq) without
+    /// A sphere of `radius` \[m\] and `density` [kg/m³] released in quiescent MnCl₂(aq) without
     /// a magnet, with Stokes drag: the set-up of the exact unsteady-Stokes release
     /// (`stokes_reference::StokesRelease`) used to validate the history quadrature.
     ///
@@ -115,12 +115,12 @@ impl SphereInLiquid {
         }
     }
 
-    /// Volume [m³].
+    /// Volume \[m³\].
     pub fn volume(&self) -> f64 {
         std::f64::consts::PI * self.diameter.powi(3) / 6.0
     }
 
-    /// Net force without drag and history at height y [N] (gravity, buoyancy, magnetic
+    /// Net force without drag and history at height y \[N\] (gravity, buoyancy, magnetic
     /// buoyancy, as switched on).
     pub fn static_force(&self, y: f64) -> f64 {
         let v = self.volume();
@@ -139,7 +139,7 @@ impl SphereInLiquid {
         f
     }
 
-    /// Integrate from (y0 [m], v0 [m/s]) at t = 0 to `t_end` [s] with step `dt` [s], keeping
+    /// Integrate from (y0 \[m\], v0 [m/s]) at t = 0 to `t_end` \[s\] with step `dt` \[s\], keeping
     /// every `sample_every`-th state (and the first and last).
     ///
     /// # Errors

@@ -116,7 +116,7 @@ fn talbot(f: impl Fn(Complex) -> Complex, t: f64, nodes: usize) -> f64 {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StokesRelease {
-    /// Sphere radius `a` [m]. Range: `> 0`.
+    /// Sphere radius `a` \[m\]. Range: `> 0`.
     pub radius: f64,
     /// Particle density `ρ_p` [kg/m³].
     pub particle_density: f64,
@@ -124,7 +124,7 @@ pub struct StokesRelease {
     pub fluid_density: f64,
     /// Dynamic viscosity `μ` [Pa s]. Range: `> 0`.
     pub viscosity: f64,
-    /// Constant force `F` along the axis of motion [N], e.g. `(ρ_p − ρ_f) V g`.
+    /// Constant force `F` along the axis of motion \[N\], e.g. `(ρ_p − ρ_f) V g`.
     pub force: f64,
     /// Velocity `v0` at release `t = 0` [m/s] (a slip step: enters with the jump term).
     /// Default: 0.
@@ -134,8 +134,8 @@ pub struct StokesRelease {
 }
 
 impl StokesRelease {
-    /// Released from rest, with history: radius `a` [m], densities `ρ_p`, `ρ_f` [kg/m³],
-    /// viscosity `μ` [Pa s], force `F` [N].
+    /// Released from rest, with history: radius `a` \[m\], densities `ρ_p`, `ρ_f` [kg/m³],
+    /// viscosity `μ` [Pa s], force `F` \[N\].
     ///
     /// ```
     /// use magsep_systems::fluid::stokes_reference::StokesRelease;
@@ -204,7 +204,7 @@ impl StokesRelease {
         self
     }
 
-    /// Sphere volume `V = (4/3)πa³` [m³].
+    /// Sphere volume `V = (4/3)πa³` \[m³\].
     ///
     /// ```
     /// use magsep_systems::fluid::stokes_reference::StokesRelease;
@@ -215,7 +215,7 @@ impl StokesRelease {
         4.0 / 3.0 * PI * self.radius.powi(3)
     }
 
-    /// Effective mass with added mass, `M = (ρ_p + ρ_f/2) V` [kg].
+    /// Effective mass with added mass, `M = (ρ_p + ρ_f/2) V` \[kg\].
     ///
     /// ```
     /// use magsep_systems::fluid::stokes_reference::StokesRelease;
@@ -264,7 +264,7 @@ impl StokesRelease {
         self.force / self.drag_coefficient()
     }
 
-    /// Viscous time `a²/ν` [s].
+    /// Viscous time `a²/ν` \[s\].
     ///
     /// ```
     /// use magsep_systems::fluid::stokes_reference::StokesRelease;
@@ -275,7 +275,7 @@ impl StokesRelease {
         self.radius * self.radius * self.fluid_density / self.viscosity
     }
 
-    /// Relaxation time `τ = M/(6πμa)` [s] (the exponential time constant without history).
+    /// Relaxation time `τ = M/(6πμa)` \[s\] (the exponential time constant without history).
     ///
     /// ```
     /// use magsep_systems::fluid::stokes_reference::StokesRelease;
@@ -296,7 +296,7 @@ impl StokesRelease {
         num.fdiv(den)
     }
 
-    /// Velocity `v(t)` [m/s] at time `t` [s] after release (`v0` for `t ≤ 0`, `v_∞` for
+    /// Velocity `v(t)` [m/s] at time `t` \[s\] after release (`v0` for `t ≤ 0`, `v_∞` for
     /// `t = ∞`; NaN for NaN).
     ///
     /// ```
@@ -317,7 +317,7 @@ impl StokesRelease {
         }
     }
 
-    /// Position `x(t)` [m] at time `t` [s] after release from `x = 0` (0 for `t ≤ 0`;
+    /// Position `x(t)` \[m\] at time `t` \[s\] after release from `x = 0` (0 for `t ≤ 0`;
     /// `v_∞ · ∞` for `t = ∞`; NaN for NaN).
     ///
     /// ```

@@ -35,11 +35,11 @@ pub struct FluidDomain(pub CollisionDomain);
 pub struct BassetHistory(pub HistoryState);
 
 /// A collision during the last step that the history must restart from: (absolute time
-/// t_c [s], jump v(t_c⁻) − v(t_c⁺) [m/s]).
+/// t_c \[s\], jump v(t_c⁻) − v(t_c⁺) [m/s]).
 #[derive(Component, Debug, Clone, Copy, Default)]
 pub struct PendingHistoryReset(pub Option<(f64, DVec3)>);
 
-/// Position at the start of the step [m] (the collision step re-advances from it).
+/// Position at the start of the step \[m\] (the collision step re-advances from it).
 #[derive(Component, Debug, Clone, Copy, Default)]
 pub struct StepStart(pub DVec3);
 

@@ -9,7 +9,7 @@
 //! [`compute_kernel_forces`] writes the sum at the step start into the built-in contribution
 //! [`KernelForce`], so `NetForce` shows it like any other contribution.
 //!
-//! Units: positions [m], times [s], forces [N], torques about the particle's centre [N m].
+//! Units: positions \[m\], times \[s\], forces \[N\], torques about the particle's centre [N m].
 //!
 //! ```
 //! use glam::DVec3;
@@ -43,19 +43,19 @@ use magsep_components::shape::Shape;
 pub struct ParticleState {
     /// The particle's `ParticleId`.
     pub id: u64,
-    /// Centre [m]. Periodic pipelines may pass unwrapped centres (outside the box): wrap
+    /// Centre \[m\]. Periodic pipelines may pass unwrapped centres (outside the box): wrap
     /// them yourself if the force is periodic.
     pub position: DVec3,
     /// Orientation (body z = rod axis; identity for spheres that do not track it).
     pub orientation: DQuat,
-    /// Shape (lengths [m]).
+    /// Shape (lengths \[m\]).
     pub shape: Shape,
-    /// Time [s] (the start of the step, or of the sub-step being evaluated).
+    /// Time \[s\] (the start of the step, or of the sub-step being evaluated).
     pub time: f64,
 }
 
 impl ParticleState {
-    /// A sphere of radius `radius` [m] at `position` [m], time `time` [s].
+    /// A sphere of radius `radius` \[m\] at `position` \[m\], time `time` \[s\].
     pub fn sphere(id: u64, position: DVec3, radius: f64, time: f64) -> Self {
         Self {
             id,
@@ -66,7 +66,7 @@ impl ParticleState {
         }
     }
 
-    /// The radius R [m] of the shape (smallest semi-axis for superquadrics).
+    /// The radius R \[m\] of the shape (smallest semi-axis for superquadrics).
     pub fn radius(&self) -> f64 {
         self.shape.radius()
     }
@@ -78,7 +78,7 @@ impl ParticleState {
 /// Implementations must be pure (same input, same output) so that re-evaluation at sub-steps
 /// and runs at any thread count agree.
 pub trait ExternalForce: Send + Sync {
-    /// Force [N] and torque about the centre [N m] on particle `p`.
+    /// Force \[N\] and torque about the centre [N m] on particle `p`.
     fn force_torque(&self, p: &ParticleState) -> (DVec3, DVec3);
 }
 
@@ -115,7 +115,7 @@ impl ExternalForces {
         self.kernels.len()
     }
 
-    /// Sum of all kernels on `p` in registration order: force [N], torque [N m].
+    /// Sum of all kernels on `p` in registration order: force \[N\], torque [N m].
     pub fn force_torque(&self, p: &ParticleState) -> (DVec3, DVec3) {
         let (mut f, mut t) = (DVec3::ZERO, DVec3::ZERO);
         for (_, k) in &self.kernels {
@@ -224,7 +224,7 @@ impl ForceUse {
 }
 
 impl ExternalForces {
-    /// Evaluate the kernels on dense particles: `out[i]` = (force [N], torque [N m]) on the
+    /// Evaluate the kernels on dense particles: `out[i]` = (force \[N\], torque [N m]) on the
     /// particle `state(i)` describes, zero where it returns `None`. Parallel above 512
     /// particles; every entry is a fixed-order sum, so the result does not depend on the
     /// thread count.

@@ -14,11 +14,11 @@ use glam::DVec3;
 /// Result of [`segment_closest`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SegmentClosest {
-    /// Vector from i's closest axis point to j's closest axis point [m].
+    /// Vector from i's closest axis point to j's closest axis point \[m\].
     pub k: DVec3,
-    /// Position of i's closest point along u_i from x_i (l_ij of the thesis) [m].
+    /// Position of i's closest point along u_i from x_i (l_ij of the thesis) \[m\].
     pub s: f64,
-    /// Position of j's closest point along u_j from x_j [m].
+    /// Position of j's closest point along u_j from x_j \[m\].
     pub t: f64,
 }
 

@@ -77,7 +77,7 @@ pub fn inertia_body_unit_density(shape: &Shape) -> DVec3 {
     DVec3::new(ixy, ixy, iz)
 }
 
-/// Radius of the smallest sphere about the centre that contains the shape [m] (for a
+/// Radius of the smallest sphere about the centre that contains the shape \[m\] (for a
 /// superquadric with unequal exponents an upper bound tight to round-off).
 ///
 /// ```

@@ -36,7 +36,7 @@ pub struct Body {
 }
 
 impl Body {
-    /// The body of `shape` scaled by `1/d` (d = reference diameter [m]).
+    /// The body of `shape` scaled by `1/d` (d = reference diameter \[m\]).
     pub fn from_shape(shape: &Shape, d: f64) -> Self {
         let scaled = match *shape {
             Shape::Sphere { radius } => Shape::Sphere { radius: radius / d },

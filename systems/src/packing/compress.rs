@@ -48,7 +48,7 @@ pub struct DriverParams {
 }
 
 impl DriverParams {
-    /// From a validated [`PackingConfig`] with reference diameter `d` [m].
+    /// From a validated [`PackingConfig`] with reference diameter `d` \[m\].
     pub fn from_config(c: &PackingConfig, d: f64) -> Self {
         let rule = match c.scheme {
             magsep_components::packing::OverlapRemovalScheme::Revised => {

@@ -1,7 +1,7 @@
 //! External force kernels ([`crate::forces::ExternalForce`]) in the FIRE minimiser's reduced
 //! units.
 //!
-//! **Positions.** The kernels see SI data: the centre x = x̃ D [m] (x̃ the reduced centre, D
+//! **Positions.** The kernels see SI data: the centre x = x̃ D \[m\] (x̃ the reduced centre, D
 //! the reference diameter; in a periodic box the centre as the minimiser holds it, which may
 //! lie outside the box), the particle's SI shape, its orientation and the step's time.
 //!
@@ -27,18 +27,18 @@ use crate::forces::{ExternalForces, ParticleState};
 pub struct PackingKernels<'a> {
     /// Kernels in registration order.
     pub kernels: &'a ExternalForces,
-    /// Reference diameter D [m].
+    /// Reference diameter D \[m\].
     pub d: f64,
     /// SI shapes in `ParticleId` order.
     pub shapes: &'a [Shape],
     /// `ParticleId`s in dense order.
     pub ids: &'a [u64],
-    /// Time of the step [s].
+    /// Time of the step \[s\].
     pub time: f64,
 }
 
 impl PackingKernels<'_> {
-    /// SI forces [N] and torques [N m] at configuration `state`.
+    /// SI forces \[N\] and torques [N m] at configuration `state`.
     pub fn si(&self, state: &PackingState, out: &mut [(DVec3, DVec3)]) {
         self.kernels.evaluate_dense(
             |i| {

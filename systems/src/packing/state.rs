@@ -34,8 +34,8 @@ pub struct PackingState {
 }
 
 impl PackingState {
-    /// Build from SI data; `edges` [m] and `walls` (in reduced units) describe the container,
-    /// `d` is the reference diameter [m].
+    /// Build from SI data; `edges` \[m\] and `walls` (in reduced units) describe the container,
+    /// `d` is the reference diameter \[m\].
     pub fn from_si(
         edges: DVec3,
         walls: WallKind,
@@ -64,7 +64,7 @@ impl PackingState {
         }
     }
 
-    /// Edges [m] and positions [m] for reference diameter `d`.
+    /// Edges \[m\] and positions \[m\] for reference diameter `d`.
     pub fn to_si(&self, d: f64) -> (DVec3, Vec<DVec3>) {
         (
             self.edges * d,

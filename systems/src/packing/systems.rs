@@ -37,7 +37,7 @@ pub struct McmWorkspace {
     pub list: NeighbourList,
     /// Driver random stream (sweep order).
     pub rng: Xoshiro256PlusPlus,
-    /// Reference diameter D [m] of the reduced units.
+    /// Reference diameter D \[m\] of the reduced units.
     pub reference_diameter: f64,
     /// Particle entities in `ParticleId` order.
     pub entities: Vec<Entity>,
@@ -105,7 +105,7 @@ pub fn init_mcm_workspace(world: &mut World) {
 pub struct DriverRng(pub Xoshiro256PlusPlus);
 
 /// The kernel's wall geometry (reduced units) of `container`, whose lengths are divided by
-/// the reference diameter `d` [m].
+/// the reference diameter `d` \[m\].
 pub fn wall_kind(container: &Container, d: f64) -> WallKind {
     match container {
         Container::PeriodicBox { .. } | Container::Unbounded => WallKind::Periodic,
@@ -120,7 +120,7 @@ pub fn wall_kind(container: &Container, d: f64) -> WallKind {
     }
 }
 
-/// The container of a kernel state with reference diameter `d` [m] (SI).
+/// The container of a kernel state with reference diameter `d` \[m\] (SI).
 pub fn container_of(state: &PackingState, d: f64) -> Container {
     let edges = state.edges * d;
     let walls = match state.walls {
@@ -151,7 +151,7 @@ pub fn state_from_si(
     )
 }
 
-/// The reference diameter of a set of shapes: the smallest particle diameter 2R [m].
+/// The reference diameter of a set of shapes: the smallest particle diameter 2R \[m\].
 pub fn reference_diameter<'a>(shapes: impl Iterator<Item = &'a Shape>) -> f64 {
     let d = shapes
         .map(|s| 2.0 * s.radius())
@@ -252,7 +252,7 @@ pub struct PackingObservables {
     pub mean_contact_number_1e_4: f64,
     /// Nematic order S.
     pub nematic_order: f64,
-    /// Largest remaining overlap [m].
+    /// Largest remaining overlap \[m\].
     pub max_overlap: f64,
     /// Contact-number histogram (index = number of contacts).
     pub contact_histogram: Vec<u64>,
@@ -261,7 +261,7 @@ pub struct PackingObservables {
     pub wall_aligned_fraction: Option<f64>,
     /// Cubatic order S_4 (eq. 4.17) of superquadrics; None without them.
     pub cubatic_order: Option<f64>,
-    /// Largest penetration of a particle into a wall [m] (<= 0 without walls).
+    /// Largest penetration of a particle into a wall \[m\] (<= 0 without walls).
     pub max_wall_penetration: f64,
     /// Whether they were ever computed.
     pub computed: bool,

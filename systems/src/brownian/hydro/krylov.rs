@@ -7,7 +7,7 @@
 //! tridiagonal (α on the diagonal, β off it), and
 //!   y_m = ‖w‖ V_m T_m^{1/2} e₁.
 //! T_m^{1/2} e₁ = Z Λ^{1/2} Zᵀ e₁ from the eigen-decomposition T_m = Z Λ Zᵀ (implicit QL with
-//! Wilkinson-type shifts, [`tridiagonal_eigen`]; negative round-off eigenvalues are clamped to
+//! Wilkinson-type shifts, `tridiagonal_eigen`; negative round-off eigenvalues are clamped to
 //! 0). Iteration stops when the relative change ‖y_m − y_{m−1}‖/‖y_m‖ < tol (Ando et al.'s
 //! criterion; because V is orthonormal this equals ‖c_m − (c_{m−1}, 0)‖/‖c_m‖ for the small
 //! coefficient vectors c_m = ‖w‖ T_m^{1/2} e₁), on an invariant subspace (β_m ≈ 0, exact) or

@@ -24,7 +24,7 @@
 //! order, so every output is bitwise identical whatever the rayon thread count.
 //!
 //! # Units
-//! SI: positions and radii [m], viscosity [Pa s], forces [N], μ [m/(N s)], velocities [m/s].
+//! SI: positions and radii \[m\], viscosity [Pa s], forces \[N\], μ [m/(N s)], velocities [m/s].
 //! `noise` returns B w in units of √μ; the caller multiplies by √(2 k_B T) and uses w = ΔW.
 //!
 //! # Assumptions

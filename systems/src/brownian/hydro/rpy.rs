@@ -36,8 +36,8 @@ use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// RPY mobility block μ_ij [m/(N s)] between two *distinct* particles, `r = x_i − x_j` [m],
-/// radii `a_i`, `a_j` [m], `viscosity` η [Pa s] (Zuk et al. 2014, see module docs).
+/// RPY mobility block μ_ij [m/(N s)] between two *distinct* particles, `r = x_i − x_j` \[m\],
+/// radii `a_i`, `a_j` \[m\], `viscosity` η [Pa s] (Zuk et al. 2014, see module docs).
 ///
 /// The self block (i == j) is I/(6πηa_i) and is the caller's job; for two distinct
 /// particles at the same centre this returns I/(6πη max(a_i, a_j)).

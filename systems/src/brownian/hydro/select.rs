@@ -4,7 +4,7 @@
 use super::{HydroError, Mobility, MobilityMethod};
 
 /// Relative covariance error ‖B Bᵀ − μ‖_F / ‖μ‖_F of the factor used by `mob`, against the
-/// exact mobility `exact` (e.g. from [`rpy_matrix`]); 0 up to rounding for Cholesky. For a
+/// exact mobility `exact` (e.g. from [`rpy_matrix`](super::rpy::rpy_matrix)); 0 up to rounding for Cholesky. For a
 /// cost/accuracy chart. O(N³) (dense product); for Krylov also 3N noise evaluations.
 pub fn covariance_error(mob: &Mobility, exact: &faer::Mat<f64>) -> Result<f64, HydroError> {
     if mob.method() == MobilityMethod::FreeDraining {

@@ -69,13 +69,13 @@ pub enum InverseInertia<'a> {
 /// The particle arrays of one step, all of length `N`, in a stable particle order.
 #[derive(Debug)]
 pub struct ParticleArrays<'a> {
-    /// In: positions at the start of the step; out: at the end (unwrapped) [m].
+    /// In: positions at the start of the step; out: at the end (unwrapped) \[m\].
     pub positions: &'a mut [DVec3],
     /// In: velocities after the force update; out: after the collisions [m/s].
     pub velocities: &'a mut [DVec3],
     /// In/out like `velocities` [rad/s].
     pub angular_velocities: &'a mut [DVec3],
-    /// Radii [m].
+    /// Radii \[m\].
     pub radii: &'a [f64],
     /// Inverse masses [1/kg] (0: immovable particle).
     pub inv_masses: &'a [f64],
@@ -102,7 +102,7 @@ pub struct CollisionEvent {
     pub particle: usize,
     /// The other body.
     pub partner: Partner,
-    /// Time within the step [s].
+    /// Time within the step \[s\].
     pub time: f64,
     /// Normal approach speed [m/s].
     pub approach_speed: f64,
@@ -117,7 +117,7 @@ pub struct CollisionEvent {
 /// A particle's last collision in the step (to reset its Basset history).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LastCollision {
-    /// Time within the step [s].
+    /// Time within the step \[s\].
     pub time: f64,
     /// Velocity just before [m/s].
     pub velocity_before: DVec3,

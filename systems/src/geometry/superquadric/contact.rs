@@ -22,7 +22,7 @@ pub struct ContactOptions {
     /// Gap below which Newton computes the contact, in units of the smallest semi-axis L of
     /// the pair. Default: 0.05. Range: >= 0 (infinite: always polish).
     pub newton_band: f64,
-    /// Newton tolerance: normal misalignment [rad] and residual lengths (tangential part of
+    /// Newton tolerance: normal misalignment \[rad\] and residual lengths (tangential part of
     /// k, distance of the points from their surfaces) in units of the smallest semi-axis.
     /// Default: 1e-12. Range: > 0.
     pub tolerance: f64,
@@ -31,7 +31,7 @@ pub struct ContactOptions {
     /// Polish with Newton; `false` returns the GJK/EPA answer alone (GJK then always runs
     /// to its full precision). Default: true.
     pub polish: bool,
-    /// Gap [m] beyond which gaps are not computed. GJK stops as soon as it knows that the
+    /// Gap \[m\] beyond which gaps are not computed. GJK stops as soon as it knows that the
     /// gap exceeds c = max(`gap_cutoff`, `newton_band` L) (status
     /// [`ContactStatus::SeparatedGjk`], overlap only an upper bound, below -c); pairs known
     /// to be closer leave GJK early and Newton computes their gap exactly. Infinity: GJK
@@ -89,9 +89,9 @@ pub enum ContactStatus {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WarmStart {
-    /// Point on a, body frame of a [m].
+    /// Point on a, body frame of a \[m\].
     pub s_a: DVec3,
-    /// Point on b, body frame of b [m].
+    /// Point on b, body frame of b \[m\].
     pub s_b: DVec3,
 }
 
@@ -107,13 +107,13 @@ pub struct WarmStart {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactResult {
-    /// Overlap depth along the common normal [m]: > 0 overlap, < 0 gap.
+    /// Overlap depth along the common normal \[m\]: > 0 overlap, < 0 gap.
     pub overlap: f64,
     /// Lab-frame unit outward normal of a at its contact point (towards b).
     pub normal: DVec3,
-    /// Contact point on a relative to a's centre, lab frame [m].
+    /// Contact point on a relative to a's centre, lab frame \[m\].
     pub rc_a: DVec3,
-    /// Contact point on b relative to b's centre, lab frame [m].
+    /// Contact point on b relative to b's centre, lab frame \[m\].
     pub rc_b: DVec3,
     /// How the answer was obtained.
     pub status: ContactStatus,
@@ -152,13 +152,13 @@ impl ContactResult {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GjkEpaContact {
-    /// Overlap [m] (> 0 penetration, < 0 gap) as parry reports it.
+    /// Overlap \[m\] (> 0 penetration, < 0 gap) as parry reports it.
     pub overlap: f64,
     /// Lab-frame unit normal of a towards b.
     pub normal: DVec3,
-    /// Witness point on a relative to a's centre, lab frame [m].
+    /// Witness point on a relative to a's centre, lab frame \[m\].
     pub rc_a: DVec3,
-    /// Witness point on b relative to b's centre, lab frame [m].
+    /// Witness point on b relative to b's centre, lab frame \[m\].
     pub rc_b: DVec3,
 }
 

@@ -194,7 +194,7 @@ pub(crate) fn bounding_radius_numeric(a: DVec3, g: DVec3) -> f64 {
     (amax2 * best).sqrt() * (1.0 + 1e-14)
 }
 
-/// Radius of the smallest centred sphere containing the superquadric (App. 4.C) [m]: the
+/// Radius of the smallest centred sphere containing the superquadric (App. 4.C) \[m\]: the
 /// closed form 4.38/4.39 for equal exponents, a numerical upper bound (tight to round-off)
 /// otherwise. An exponent that is not finite gives the box bound |a|.
 ///

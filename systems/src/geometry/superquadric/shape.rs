@@ -25,7 +25,7 @@ pub const MAX_EXPONENT: f64 = 100.0;
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Superquadric {
-    /// Semi-axes (a1, a2, a3) along body x, y, z [m]; each > 0.
+    /// Semi-axes (a1, a2, a3) along body x, y, z \[m\]; each > 0.
     pub semi_axes: DVec3,
     /// Exponents (g1, g2, g3), each in [2, [`MAX_EXPONENT`]] (strictly convex).
     pub exponents: DVec3,
@@ -144,7 +144,7 @@ impl Superquadric {
         self.prepared().support(dir)
     }
 
-    /// Support function h(dir) = dir . support(dir) (the extent along a unit `dir`) [m].
+    /// Support function h(dir) = dir . support(dir) (the extent along a unit `dir`) \[m\].
     ///
     /// ```
     /// use glam::DVec3;
@@ -209,7 +209,7 @@ impl Superquadric {
         superquadric_inertia(self.semi_axes, self.exponents)
     }
 
-    /// Circumscribed (bounding) sphere radius about the centre (App. 4.C, erratum E-000-7) [m].
+    /// Circumscribed (bounding) sphere radius about the centre (App. 4.C, erratum E-000-7) \[m\].
     ///
     /// ```
     /// use magsep_systems::geometry::superquadric::Superquadric;
