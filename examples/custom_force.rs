@@ -1,44 +1,37 @@
-//! (a) A user plugin that registers a force contribution and a system computing it.
+//! (a) A user plugin that adds a force to a pipeline: a harmonic trap as an external force
+//! kernel.
 //!
-//! `TrapForce` pulls every particle towards the box centre, F = -k (x - c). The plugin
-//! registers the contribution (so `Accumulate` sums it into `NetForce` in a fixed order) and
-//! adds `compute_trap_force` to `ForceSystems::Custom`. Run: `cargo run --example custom_force`.
+//! `Trap` pulls every particle towards the box centre, F = -k (x - c). A kernel is a function
+//! of the particle's state (position [m], orientation, shape, time [s]) returning force [N]
+//! and torque [N m]; every pipeline evaluates it wherever it needs forces: the brownian
+//! stepper at every adaptive sub-step, the packing's FIRE minimiser at every iteration, the
+//! particle-fluid integrator once per step. Its value at the step start is also the built-in
+//! contribution `KernelForce`, summed into `NetForce`. Run: `cargo run --example custom_force`.
 
-use bevy_ecs::prelude::*;
+use std::sync::Arc;
+
 use glam::DVec3;
+use magsep::components::forces::KernelForce;
 use magsep::prelude::*;
 use magsep::scene::parse_scene;
+use magsep::systems::forces::{ExternalForce, ParticleState};
 
-/// Harmonic trap towards the box centre [N].
-#[derive(Component, Debug, Default, Clone, Copy)]
-pub struct TrapForce(pub DVec3);
+/// Harmonic trap F = -k (x - c).
+#[derive(Debug, Clone, Copy)]
+pub struct Trap {
+    /// Stiffness k [N/m].
+    pub stiffness: f64,
+    /// Centre c [m].
+    pub centre: DVec3,
+}
 
-impl ForceContribution for TrapForce {
-    fn force(&self) -> DVec3 {
-        self.0
-    }
-    fn clear(&mut self) {
-        self.0 = DVec3::ZERO;
+impl ExternalForce for Trap {
+    fn force_torque(&self, p: &ParticleState) -> (DVec3, DVec3) {
+        (-self.stiffness * (p.position - self.centre), DVec3::ZERO)
     }
 }
 
-/// Trap stiffness k [N/m].
-#[derive(Resource, Debug, Clone, Copy)]
-pub struct TrapStiffness(pub f64);
-
-/// Forces::Custom: F = -k (x - centre).
-pub fn compute_trap_force(
-    k: Res<TrapStiffness>,
-    container: Res<Container>,
-    mut q: Query<(&Position, &mut TrapForce)>,
-) {
-    let centre = container.edges() * 0.5;
-    for (p, mut f) in &mut q {
-        f.0 = -k.0 * (p.0 - centre);
-    }
-}
-
-/// Inserts the stiffness, adds `TrapForce` to every particle, registers the contribution.
+/// Registers a [`Trap`] at the centre of the scene's container.
 #[derive(Debug, Clone, Copy)]
 pub struct TrapPlugin {
     /// Stiffness [N/m].
@@ -47,11 +40,21 @@ pub struct TrapPlugin {
 
 impl SimPlugin for TrapPlugin {
     fn build(&self, app: &mut SimApp) {
-        app.world.insert_resource(TrapStiffness(self.stiffness));
-        app.insert_on_particles(TrapForce::default());
-        app.register_force::<TrapForce>();
-        app.schedule
-            .add_systems(compute_trap_force.in_set(ForceSystems::Custom));
+        let centre = app
+            .world
+            .get_resource::<Container>()
+            .map_or(DVec3::ZERO, |c| c.edges() * 0.5);
+        app.add_external_force(
+            "trap",
+            Arc::new(Trap {
+                stiffness: self.stiffness,
+                centre,
+            }),
+        );
+    }
+
+    fn params(&self) -> serde_json::Value {
+        serde_json::json!({ "stiffness": self.stiffness })
     }
 }
 
@@ -66,7 +69,7 @@ count = 20
 shape = { kind = "sphere", radius = 0.5 }
 "#;
 
-/// Runs three steps and returns (net force, expected trap force) of particle 0.
+/// Runs three packing steps and returns (net force, trap contribution) of particle 0 [N].
 pub fn demo() -> (DVec3, DVec3) {
     let scene = parse_scene(SCENE, &Default::default()).expect("valid scene");
     let pipeline = packing_pipeline().add(TrapPlugin { stiffness: 2.0 });
@@ -82,17 +85,18 @@ pub fn demo() -> (DVec3, DVec3) {
         sim.step();
     }
     // Forces and Accumulate ran before this step's Constraints moved the particle, so NetForce
-    // equals the stored contribution (the only one registered).
+    // equals the stored kernel contribution (the only one registered). The FIRE minimiser
+    // re-evaluated the kernel at every iteration of the overlap removal.
     let world = &mut sim.app.world;
-    let mut q = world.query::<(&ParticleId, &NetForce, &TrapForce)>();
+    let mut q = world.query::<(&ParticleId, &NetForce, &KernelForce)>();
     let (_, net, trap) = q
         .iter(world)
         .find(|(id, _, _)| id.0 == 0)
         .expect("particle 0");
-    (net.0, trap.0)
+    (net.0, trap.force)
 }
 
 fn main() {
     let (net, trap) = demo();
-    println!("particle 0: NetForce {net}, TrapForce contribution {trap}");
+    println!("particle 0: NetForce {net}, trap contribution {trap}");
 }

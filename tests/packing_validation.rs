@@ -46,23 +46,14 @@ fn spheres_small_reach_a_dense_random_packing() {
     assert!(r.contact_number > 5.0 && r.contact_number < 6.5, "{r:?}");
 }
 
-/// The thesis-size packings take minutes each: they run only in the full tier
-/// (`MAGSEP_FULL_VALIDATION=1 cargo test --release -- --ignored`), so that CI stays well
-/// inside its time budget; the fast versions above run in the default tier.
-fn full_tier(name: &str) -> bool {
-    let on = std::env::var_os("MAGSEP_FULL_VALIDATION").is_some();
-    if !on {
-        eprintln!("{name}: full tier, set MAGSEP_FULL_VALIDATION=1 to run");
-    }
-    on
-}
+// The thesis-size packings take minutes each: they form the full tier, ignored tests named
+// `full_tier_*` that the release tier of CI skips (`--skip full_tier_`) to stay inside its time
+// budget; run them with `cargo test --release --workspace -- --ignored full_tier_`. The fast
+// versions above run in the default tier.
 
 #[test]
-#[ignore = "full validation tier (release, MAGSEP_FULL_VALIDATION=1): N = 500, 3 seeds"]
-fn spheres_500_random_close_packing() {
-    if !full_tier("spheres_500_random_close_packing") {
-        return;
-    }
+#[ignore = "full tier (minutes, release): N = 500, 3 seeds; cargo test --release -- --ignored full_tier_"]
+fn full_tier_spheres_500_random_close_packing() {
     let runs: Vec<PackingRun> = (1..=3).map(|s| run(500, SPHERE, s, |_| {})).collect();
     let phi = runs.iter().map(|r| r.packing_fraction).sum::<f64>() / 3.0;
     let c = runs.iter().map(|r| r.contact_number).sum::<f64>() / 3.0;
@@ -82,11 +73,8 @@ fn long_rods_small_follow_the_random_contact_equation_roughly() {
 }
 
 #[test]
-#[ignore = "full validation tier (release, MAGSEP_FULL_VALIDATION=1): N = 500 rods of aspect ratio 25 (thesis size)"]
-fn long_rods_random_contact_equation() {
-    if !full_tier("long_rods_random_contact_equation") {
-        return;
-    }
+#[ignore = "full tier (minutes, release): N = 500 rods of aspect ratio 25 (thesis size); cargo test --release -- --ignored full_tier_"]
+fn full_tier_long_rods_random_contact_equation() {
     // N = 500 as in the thesis: with N = 300 the box (32 D) is barely longer than a rod and
     // phi (aspect - 1) drops to 4.3
     let aspect = 25.0;

@@ -80,3 +80,28 @@ macro_rules! force_contribution {
         }
     };
 }
+
+/// The sum of the registered external force kernels at the particle at the start of the step
+/// (a built-in contribution, written by `magsep_systems::forces::compute_kernel_forces` when a
+/// kernel is registered): force [N] and torque about the centre [N m]. Pipelines that
+/// integrate with sub-steps re-evaluate the kernels themselves; this component is what the
+/// step-start `NetForce` holds.
+#[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KernelForce {
+    /// Force [N].
+    pub force: DVec3,
+    /// Torque about the centre [N m].
+    pub torque: DVec3,
+}
+
+impl ForceContribution for KernelForce {
+    fn force(&self) -> DVec3 {
+        self.force
+    }
+    fn torque(&self) -> DVec3 {
+        self.torque
+    }
+    fn clear(&mut self) {
+        *self = Self::default();
+    }
+}

@@ -4,12 +4,17 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleBuildError;
-use magsep_systems::forces::ForceRegistry;
+use magsep_components::forces::{ForceContribution, KernelForce};
+use magsep_components::particle::ParticleId;
+use magsep_systems::forces::{
+    ExternalForce, ExternalForces, ForceRegistry, ForceUse, compute_kernel_forces,
+};
 use magsep_systems::sets::{
-    ObserveSchedule, new_sim_schedule, resolved_schedule, strict_build_settings,
+    ForceSystems, ObserveSchedule, new_sim_schedule, resolved_schedule, strict_build_settings,
 };
 use std::any::Any;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// A unit of wiring: adds resources and systems to a [`SimApp`].
 ///
@@ -49,6 +54,10 @@ pub trait SimPlugin: Any + Send + Sync {
             .unwrap_or("plugin")
             .to_string()
     }
+    /// The plugin's parameters, recorded with the run (default: none, `null`).
+    fn params(&self) -> serde_json::Value {
+        serde_json::Value::Null
+    }
 }
 
 /// A schedule that cannot be built (ambiguity, cycle), with the systems named.
@@ -80,6 +89,7 @@ pub struct SimApp {
     pub forces: ForceRegistry,
     plugins: Vec<FinishHook>,
     plugin_names: Vec<String>,
+    plugin_params: Vec<serde_json::Value>,
 }
 
 impl Default for SimApp {
@@ -103,29 +113,103 @@ impl SimApp {
             forces: ForceRegistry::default(),
             plugins: Vec::new(),
             plugin_names: Vec::new(),
+            plugin_params: Vec::new(),
         }
     }
 
     /// Build `plugin` into this app.
     pub fn add_plugin<P: SimPlugin + Clone>(&mut self, plugin: &P) -> &mut Self {
-        plugin.build(self);
-        let p = plugin.clone();
-        self.plugin_names.push(plugin.name());
-        self.plugins.push(Box::new(move |w| p.finish(w)));
-        self
+        self.add_boxed_plugin(Arc::new(plugin.clone()))
     }
 
     /// Build a boxed plugin (used by [`crate::PipelineGroup`]).
-    pub fn add_boxed_plugin(&mut self, plugin: std::sync::Arc<dyn SimPlugin>) -> &mut Self {
+    pub fn add_boxed_plugin(&mut self, plugin: Arc<dyn SimPlugin>) -> &mut Self {
+        let name = plugin.name();
+        self.add_named_plugin(name, plugin)
+    }
+
+    /// Build a boxed plugin under `name` (its entry name in [`Self::plugin_infos`]; a group
+    /// names several instances of one type apart).
+    pub fn add_named_plugin(&mut self, name: String, plugin: Arc<dyn SimPlugin>) -> &mut Self {
         plugin.build(self);
-        self.plugin_names.push(plugin.name());
+        self.plugin_names.push(name);
+        self.plugin_params.push(plugin.params());
         self.plugins.push(Box::new(move |w| plugin.finish(w)));
         self
     }
 
-    /// Register force contribution `T` (summed in registration order).
-    pub fn register_force<T: magsep_components::forces::ForceContribution>(&mut self) -> &mut Self {
+    /// Register force contribution `T` (summed into `NetForce` in registration order) and
+    /// attach `T::default()` to every particle (entity with a `ParticleId`): to those that
+    /// exist now and, through an observer, to those spawned later. A particle that already
+    /// has a `T` keeps it. Registering a type twice is a no-op.
+    ///
+    /// Whether the pipeline consumes the contribution is checked by [`Self::finish`]: a
+    /// contribution is a value computed once per step, and a pipeline that needs forces
+    /// elsewhere (adaptive sub-steps, a minimiser) refuses it; register an
+    /// [`ExternalForce`] kernel with [`Self::add_external_force`] instead.
+    pub fn register_force<T: ForceContribution>(&mut self) -> &mut Self {
+        let name = std::any::type_name::<T>();
+        if self.forces.names.iter().any(|n| n == name) {
+            return self;
+        }
         self.forces.register::<T>(&mut self.schedule);
+        let ids: Vec<Entity> = self
+            .world
+            .query_filtered::<Entity, With<ParticleId>>()
+            .iter(&self.world)
+            .collect();
+        for e in ids {
+            self.world.entity_mut(e).insert_if_new(T::default());
+        }
+        self.world
+            .add_observer(|add: On<Add<ParticleId>>, mut commands: Commands| {
+                commands.entity(add.entity).insert_if_new(T::default());
+            });
+        self
+    }
+
+    /// Register an external force kernel under `name` (kernels are summed in registration
+    /// order). Every pipeline evaluates the kernels where it needs forces (see
+    /// [`ExternalForce`]); the sum at the step start is also the built-in contribution
+    /// `KernelForce`, part of `NetForce`. [`Self::finish`] fails if the pipeline cannot use
+    /// kernels.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use magsep_plugins::app::SimApp;
+    /// use magsep_systems::forces::{ExternalForce, ExternalForces, ParticleState};
+    /// use std::sync::Arc;
+    ///
+    /// /// Uniform force along -z [N].
+    /// struct Weight(f64);
+    /// impl ExternalForce for Weight {
+    ///     fn force_torque(&self, _p: &ParticleState) -> (DVec3, DVec3) {
+    ///         (DVec3::new(0.0, 0.0, -self.0), DVec3::ZERO)
+    ///     }
+    /// }
+    /// let mut app = SimApp::new();
+    /// app.add_external_force("weight", Arc::new(Weight(1e-12)));
+    /// assert_eq!(app.world.resource::<ExternalForces>().names(), ["weight"]);
+    /// // no plugin consumes forces in this empty app: refused, not ignored
+    /// assert!(app.finish().unwrap_err().0.contains("weight"));
+    /// ```
+    pub fn add_external_force(
+        &mut self,
+        name: impl Into<String>,
+        kernel: Arc<dyn ExternalForce>,
+    ) -> &mut Self {
+        let first = self
+            .world
+            .get_resource::<ExternalForces>()
+            .is_none_or(|k| k.is_empty());
+        self.world
+            .get_resource_or_init::<ExternalForces>()
+            .push(name, kernel);
+        if first {
+            self.register_force::<KernelForce>();
+            self.schedule
+                .add_systems(compute_kernel_forces.in_set(ForceSystems::Custom));
+        }
         self
     }
 
@@ -148,15 +232,28 @@ impl SimApp {
         &self.plugin_names
     }
 
-    /// Run every plugin's `finish` hook, then build both schedules. Errors on ambiguities
-    /// (two systems with conflicting access and no order) and cycles.
+    /// (name, parameters) of the plugins built, in order (for the run's record).
+    pub fn plugin_infos(&self) -> Vec<(String, serde_json::Value)> {
+        self.plugin_names
+            .iter()
+            .cloned()
+            .zip(self.plugin_params.iter().cloned())
+            .collect()
+    }
+
+    /// Run every plugin's `finish` hook, check that the pipeline consumes every registered
+    /// force (the integrator plugin declares a [`ForceUse`]), then build both schedules.
+    /// Errors on forces that would be ignored, ambiguities (two systems with conflicting
+    /// access and no order) and cycles.
     ///
     /// # Errors
-    /// The schedule build error of bevy_ecs, as text naming the systems involved.
+    /// Refused forces (what, why, what to do instead), or the schedule build error of
+    /// bevy_ecs, as text naming the systems involved.
     pub fn finish(&mut self) -> Result<(), ScheduleError> {
         for f in std::mem::take(&mut self.plugins) {
             f(&mut self.world);
         }
+        self.check_force_use()?;
         self.world.insert_resource(self.forces.clone());
         if let Err(e) = self.schedule.initialize(&mut self.world) {
             return Err(ScheduleError(describe(&e, &self.schedule, &self.world)));
@@ -165,6 +262,22 @@ impl SimApp {
             return Err(ScheduleError(describe(&e, &self.observe, &self.world)));
         }
         Ok(())
+    }
+
+    /// The force check of [`Self::finish`]: nothing registered, or everything consumed.
+    fn check_force_use(&self) -> Result<(), ScheduleError> {
+        let kernels: Vec<&str> = self
+            .world
+            .get_resource::<ExternalForces>()
+            .map(|k| k.names())
+            .unwrap_or_default();
+        if self.forces.names.is_empty() && kernels.is_empty() {
+            return Ok(());
+        }
+        let default = ForceUse::default();
+        let used = self.world.get_resource::<ForceUse>().unwrap_or(&default);
+        used.check(&self.forces.names, &kernels)
+            .map_err(ScheduleError)
     }
 
     /// Run one step of the simulation schedule.

@@ -13,14 +13,19 @@
 //! | [`CaptureObservePlugin`] | `Observe` (gated) | `observe_capture` | `CaptureCurve` |
 //!
 //! Contributions `FieldForce`, `DipoleForce`, `ContactForce` are registered (summed in that
-//! order into `NetForce`). The integrator re-evaluates the three built-in contributions at
-//! every sub-step and holds any other registered contribution (a user's `Forces::Custom`
-//! plugin) fixed over the step. The forces plugin's `finish` hook gathers the particles into
-//! the dense workspace (resources `BrownianConfig`, `ExternalField`, `StepClock` must exist).
+//! order into `NetForce`). The integrator re-evaluates them, and every external force kernel
+//! (`SimApp::add_external_force`), at every adaptive sub-step, so the step controller sees
+//! the user's force. Any other registered contribution (a user's `ForceContribution`
+//! component) is a value of the step start: the integrator consumes it only with
+//! `step_control = fixed` (explicit Euler evaluates forces only there) and `SimApp::finish`
+//! refuses it with adaptive steps, naming the kernel alternative (see [`brownian_force_use`]).
+//! The forces plugin's `finish` hook gathers the particles into the dense workspace
+//! (resources `BrownianConfig`, `ExternalField`, `StepClock` must exist).
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_systems::brownian::systems::*;
+use magsep_systems::forces::{Consumption, ForceUse};
 use magsep_systems::sets::{ForceSystems, SimSystems};
 
 use crate::app::{SimApp, SimPlugin};
@@ -63,6 +68,48 @@ impl SimPlugin for BrownianIntegratorPlugin {
             integrate_brownian.in_set(SimSystems::Integrate),
             write_back_brownian.in_set(FinalizeSystems::WriteBack),
         ));
+    }
+
+    fn finish(&self, world: &mut World) {
+        let control = world
+            .get_resource::<BrownianConfig>()
+            .map(|c| c.step_control)
+            .unwrap_or_default();
+        world.insert_resource(brownian_force_use(&control));
+    }
+}
+
+/// What the brownian integrator consumes with step control `control`: the built-in field,
+/// dipole and contact contributions and kernels always; other contributions only with fixed
+/// steps.
+///
+/// ```
+/// use magsep_components::brownian::StepControl;
+/// use magsep_plugins::brownian::brownian_force_use;
+/// use magsep_systems::forces::Consumption;
+/// assert_eq!(brownian_force_use(&StepControl::Fixed).contributions, Consumption::Consumed);
+/// assert_ne!(brownian_force_use(&StepControl::default()).contributions, Consumption::Consumed);
+/// ```
+pub fn brownian_force_use(control: &StepControl) -> ForceUse {
+    let contributions = match control {
+        StepControl::Fixed => Consumption::Consumed,
+        StepControl::Adaptive { .. } => Consumption::Refused(
+            "the brownian pipeline's adaptive stepper re-evaluates forces at every sub-step, \
+             and a ForceContribution component is a value computed once per step (it would \
+             be frozen over the sub-steps); implement `magsep_systems::forces::ExternalForce` \
+             and register it with `SimApp::add_external_force` instead, or use \
+             step_control = fixed"
+                .into(),
+        ),
+    };
+    ForceUse {
+        builtin: vec![
+            std::any::type_name::<FieldForce>().into(),
+            std::any::type_name::<DipoleForce>().into(),
+            std::any::type_name::<ContactForce>().into(),
+        ],
+        contributions,
+        kernels: Consumption::Consumed,
     }
 }
 

@@ -19,7 +19,7 @@ pub mod core;
 pub mod group;
 pub mod packing;
 pub mod particle_fluid;
-pub mod record;
+pub use magsep_record as record;
 pub mod recorder;
 
 pub use app::{SimApp, SimPlugin};

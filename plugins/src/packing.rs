@@ -10,8 +10,17 @@
 //!
 //! The compression plugin's `finish` hook gathers the spawned particles into the dense
 //! `McmWorkspace` (resources `PackingConfig`, `Container`, `RunSeed` must exist).
+//!
+//! User forces: the MCM moves particles by geometric rules and never reads `NetForce`, so a
+//! `ForceContribution` component is refused at `SimApp::finish`. External force kernels
+//! (`SimApp::add_external_force`) act with the FIRE scheme, which adds them to the overlap
+//! forces at every iteration (units and scaling: `magsep_systems::packing::external`); the
+//! thesis's `original` and `revised` schemes have no forces and refuse them (see
+//! [`packing_force_use`]).
 
 use bevy_ecs::prelude::*;
+use magsep_components::packing::{OverlapRemovalScheme, PackingConfig};
+use magsep_systems::forces::{Consumption, ForceUse};
 use magsep_systems::packing::systems::*;
 use magsep_systems::sets::SimSystems;
 
@@ -38,7 +47,7 @@ impl SimPlugin for McmCompressionPlugin {
     }
 }
 
-/// Overlap removal by the MCM move rules.
+/// Overlap removal by the MCM move rules (FIRE: with the external force kernels).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct McmOverlapRemovalPlugin;
 
@@ -46,6 +55,46 @@ impl SimPlugin for McmOverlapRemovalPlugin {
     fn build(&self, app: &mut SimApp) {
         app.schedule
             .add_systems(remove_overlaps_mcm.in_set(SimSystems::Constraints));
+    }
+
+    fn finish(&self, world: &mut World) {
+        let scheme = world
+            .get_resource::<PackingConfig>()
+            .map_or(OverlapRemovalScheme::Fire, |c| c.scheme);
+        world.insert_resource(packing_force_use(scheme));
+    }
+}
+
+/// What the packing's overlap removal with `scheme` consumes: kernels with FIRE, never a
+/// `ForceContribution` component.
+///
+/// ```
+/// use magsep_components::packing::OverlapRemovalScheme;
+/// use magsep_plugins::packing::packing_force_use;
+/// use magsep_systems::forces::Consumption;
+/// assert_eq!(packing_force_use(OverlapRemovalScheme::Fire).kernels, Consumption::Consumed);
+/// assert_ne!(packing_force_use(OverlapRemovalScheme::Revised).kernels, Consumption::Consumed);
+/// ```
+pub fn packing_force_use(scheme: OverlapRemovalScheme) -> ForceUse {
+    let kernels = match scheme {
+        OverlapRemovalScheme::Fire => Consumption::Consumed,
+        OverlapRemovalScheme::Original | OverlapRemovalScheme::Revised => Consumption::Refused(
+            format!(
+                "the packing scheme {scheme:?} (the thesis's single-particle MCM moves) has no \
+                 forces; use scheme = \"fire\", which minimises the overlap energy together \
+                 with the kernels' potential"
+            ),
+        ),
+    };
+    ForceUse {
+        builtin: Vec::new(),
+        contributions: Consumption::Refused(
+            "the packing pipeline moves particles by geometric rules and never reads \
+             NetForce; implement `magsep_systems::forces::ExternalForce` and register it \
+             with `SimApp::add_external_force` (acts with scheme = \"fire\")"
+                .into(),
+        ),
+        kernels,
     }
 }
 

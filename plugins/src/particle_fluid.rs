@@ -31,6 +31,7 @@ use magsep_systems::fluid::observe::{
     SeparationCurve, observe_separation, should_observe_separation,
 };
 use magsep_systems::fluid::systems::*;
+use magsep_systems::forces::{Consumption, ForceUse};
 use magsep_systems::sets::{ForceSystems, SimSystems};
 
 use crate::app::{SimApp, SimPlugin};
@@ -126,12 +127,18 @@ impl SimPlugin for InertialForcesPlugin {
     }
 }
 
-/// Velocities, positions, periodic wrap and levitation bookkeeping.
+/// Velocities, positions, periodic wrap and levitation bookkeeping. Consumes `NetForce`, so
+/// every registered contribution and kernel acts (explicitly, evaluated at the step start).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct InertialIntegratorPlugin;
 
 impl SimPlugin for InertialIntegratorPlugin {
     fn build(&self, app: &mut SimApp) {
+        app.world.insert_resource(ForceUse {
+            builtin: Vec::new(),
+            contributions: Consumption::Consumed,
+            kernels: Consumption::Consumed,
+        });
         app.insert_on_particles(StepStart::default());
         app.schedule.add_systems((
             update_velocities.in_set(SimSystems::Mobility),

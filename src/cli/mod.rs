@@ -148,8 +148,9 @@ enum Command {
     },
     /// Benchmarks (`magsep bench packing`, `magsep bench particle-fluid --json`).
     Bench {
-        /// What to benchmark: packing, field, brownian or particle-fluid.
-        what: String,
+        /// What to benchmark.
+        #[arg(value_enum)]
+        what: crate::studies::bench::BenchKind,
         /// One JSON object per measurement on stdout.
         #[arg(long)]
         json: bool,
@@ -159,9 +160,9 @@ enum Command {
     },
     /// Charts as SVG (`magsep chart packing --out DIR`).
     Chart {
-        /// Which chart family: packing, field, brownian, brownian-cost, cylinder, wedge,
-        /// superballs, sq-contact, levitation, history, collisions or separation.
-        what: String,
+        /// Which chart family.
+        #[arg(value_enum)]
+        what: crate::studies::bench::ChartKind,
         /// Output directory.
         #[arg(long, default_value = "charts")]
         out: PathBuf,
@@ -258,10 +259,10 @@ pub fn main_with(ext: Extensions) -> i32 {
             }
         }
         Command::Bench { what, json, quick } => {
-            crate::studies::bench::bench(&what, json, quick).map_err(to_cli)
+            crate::studies::bench::bench(what, json, quick).map_err(to_cli)
         }
         Command::Chart { what, out, quick } => {
-            crate::studies::bench::chart(&what, &out, quick).map_err(to_cli)
+            crate::studies::bench::chart(what, &out, quick).map_err(to_cli)
         }
     };
     match result {

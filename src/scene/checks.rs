@@ -36,11 +36,13 @@ pub fn typed<T: DeserializeOwned>(
             let raw = e.into_inner().to_string();
             // toml appends context lines ("in `shape`"); the key path already says where
             let mut message = raw.lines().next().unwrap_or("").trim().to_string();
-            // name the key of an unknown field in the path, as users look for it there
+            // name the key of an unknown or missing field in the path, as users look for it
             let mut full = full;
-            if let Some(rest) = message.strip_prefix("unknown field `")
-                && let Some(end) = rest.find('`')
-            {
+            for (prefix, unknown) in [("unknown field `", true), ("missing field `", false)] {
+                let Some(rest) = message.strip_prefix(prefix) else {
+                    continue;
+                };
+                let Some(end) = rest.find('`') else { continue };
                 let key = &rest[..end];
                 if !(full == key || full.ends_with(&format!(".{key}"))) {
                     full = if full.is_empty() {
@@ -49,22 +51,15 @@ pub fn typed<T: DeserializeOwned>(
                         format!("{full}.{key}")
                     };
                 }
-                message = format!(
-                    "unknown key; {}",
-                    rest[end + 1..].trim_start_matches(',').trim()
-                );
-            } else if let Some(rest) = message.strip_prefix("missing field `")
-                && let Some(end) = rest.find('`')
-            {
-                let key = &rest[..end];
-                if !(full == key || full.ends_with(&format!(".{key}"))) {
-                    full = if full.is_empty() {
-                        key.to_string()
-                    } else {
-                        format!("{full}.{key}")
-                    };
-                }
-                message = "missing required key".into();
+                message = if unknown {
+                    format!(
+                        "unknown key; {}",
+                        rest[end + 1..].trim_start_matches(',').trim()
+                    )
+                } else {
+                    "missing required key".into()
+                };
+                break;
             }
             errors.push(SceneError::new(full, message));
             None

@@ -40,7 +40,7 @@ pub use pipeline::{
 };
 pub use placement::{DensityRatios, PlacementSpec};
 pub use sections::{
-    GROUP_KEYS, PIPELINE_GROUP_KEYS, ParticleGroup, RecordSection, ShapeSpec, SimulationSection,
+    GROUP_KEYS, ParticleGroup, RecordSection, ShapeSpec, SimulationSection,
 };
 pub use spawn::{RecordEvery, SceneText, spawn_scene, spawn_scene_with};
 

@@ -137,17 +137,6 @@ pub const GROUP_KEYS: &[&str] = &[
     "volume_fraction",
 ];
 
-/// The typed [`ParticleGroup`] keys that only some pipelines read (the rest, `count` and
-/// `shape`, every pipeline reads).
-pub const PIPELINE_GROUP_KEYS: &[&str] = &[
-    "moment",
-    "placement",
-    "density",
-    "density_ratios",
-    "velocity",
-    "volume_fraction",
-];
-
 /// `[record]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -174,24 +174,62 @@ pub fn log_slope(points: &[(f64, f64)]) -> f64 {
     (n * sxy - sx * sy) / (n * sxx - sx * sx)
 }
 
-/// `magsep bench packing [--json] [--quick]`.
+/// The benchmarks of `magsep bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchKind {
+    /// Packing to jamming and the cost of a sweep against N.
+    Packing,
+    /// The cylinder field kernel.
+    Field,
+    /// Brownian dynamics without and with hydrodynamics.
+    Brownian,
+    /// The history force and the particle-fluid pipeline.
+    ParticleFluid,
+}
+
+/// The charts of `magsep chart`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ChartKind {
+    /// Packing fraction against wall time; shape trends.
+    Packing,
+    /// Spherocylinders in hard cylinders.
+    Cylinder,
+    /// Spherocylinders in hard wedges.
+    Wedge,
+    /// Superballs.
+    Superballs,
+    /// Superquadric contact: failures and cost.
+    SqContact,
+    /// Field accuracy against cost.
+    Field,
+    /// Brownian capture curves.
+    Brownian,
+    /// Brownian mobilities: error against cost.
+    BrownianCost,
+    /// Single-sphere levitation.
+    Levitation,
+    /// The Basset history method.
+    History,
+    /// Binary collisions.
+    Collisions,
+    /// Many-particle density separation.
+    Separation,
+}
+
+/// `magsep bench KIND [--json] [--quick]`.
 ///
 /// # Errors
-/// [`BenchError::Input`] for an unknown target.
-pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
-    if what == "field" {
-        return crate::studies::bench_field::bench_field(as_json, quick);
-    }
-    if what == "brownian" {
-        return crate::studies::bench_brownian::bench_brownian(as_json, quick);
-    }
-    if what == "particle-fluid" {
-        return crate::studies::fluid_charts::bench_particle_fluid(as_json, quick);
-    }
-    if what != "packing" {
-        return Err(BenchError::Input(format!(
-            "unknown benchmark `{what}`; available: packing, field, brownian, particle-fluid"
-        )));
+/// [`BenchError`] of the benchmark.
+pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchError> {
+    match what {
+        BenchKind::Field => return crate::studies::bench_field::bench_field(as_json, quick),
+        BenchKind::Brownian => {
+            return crate::studies::bench_brownian::bench_brownian(as_json, quick);
+        }
+        BenchKind::ParticleFluid => {
+            return crate::studies::fluid_charts::bench_particle_fluid(as_json, quick);
+        }
+        BenchKind::Packing => {}
     }
     let threads = rayon::current_num_threads();
     let mut rows = Vec::new();
@@ -276,26 +314,25 @@ pub fn bench(what: &str, as_json: bool, quick: bool) -> Result<(), BenchError> {
     Ok(())
 }
 
-/// `magsep chart packing --out DIR [--quick]`.
+/// `magsep chart KIND --out DIR [--quick]`.
 ///
 /// # Errors
-/// [`BenchError::Input`] for an unknown chart, [`BenchError::Runtime`] for I/O.
-pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
-    if what == "brownian-cost" {
-        return crate::studies::bench_brownian::chart_brownian_cost(out, quick);
-    }
-    if what == "brownian" {
-        return crate::studies::brownian_chart::chart_brownian(out, quick);
-    }
+/// [`BenchError::Runtime`] for I/O or a failed run.
+pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError> {
+    use crate::studies::{fluid_charts as fc, packing_charts as pc};
     match what {
-        "cylinder" => return crate::studies::packing_charts::chart_cylinder(out, quick),
-        "wedge" => return crate::studies::packing_charts::chart_wedge(out, quick),
-        "superballs" => return crate::studies::packing_charts::chart_superballs(out, quick),
-        "levitation" => return crate::studies::fluid_charts::chart_levitation(out, quick),
-        "history" => return crate::studies::fluid_charts::chart_history(out, quick),
-        "collisions" => return crate::studies::fluid_charts::chart_collisions(out, quick),
-        "separation" => return crate::studies::fluid_charts::chart_separation(out, quick),
-        "sq-contact" => {
+        ChartKind::BrownianCost => {
+            return crate::studies::bench_brownian::chart_brownian_cost(out, quick);
+        }
+        ChartKind::Brownian => return crate::studies::brownian_chart::chart_brownian(out, quick),
+        ChartKind::Cylinder => return pc::chart_cylinder(out, quick),
+        ChartKind::Wedge => return pc::chart_wedge(out, quick),
+        ChartKind::Superballs => return pc::chart_superballs(out, quick),
+        ChartKind::Levitation => return fc::chart_levitation(out, quick),
+        ChartKind::History => return fc::chart_history(out, quick),
+        ChartKind::Collisions => return fc::chart_collisions(out, quick),
+        ChartKind::Separation => return fc::chart_separation(out, quick),
+        ChartKind::SqContact => {
             std::fs::create_dir_all(out)
                 .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
             let study = crate::studies::sq_study::run_sq_contact_study(quick);
@@ -304,20 +341,15 @@ pub fn chart(what: &str, out: &Path, quick: bool) -> Result<(), BenchError> {
             println!("{summary}");
             return Ok(());
         }
-        _ => {}
-    }
-    if what == "field" {
-        let rows = crate::studies::bench_field::chart_field(out, quick)?;
-        println!(
-            "{}",
-            json!({"charts": [out.join("field_error_vs_cost.svg").display().to_string()], "points": rows})
-        );
-        return Ok(());
-    }
-    if what != "packing" {
-        return Err(BenchError::Input(format!(
-            "unknown chart `{what}`; available: packing, cylinder, wedge, superballs, sq-contact, field, brownian, brownian-cost, levitation, history, collisions, separation"
-        )));
+        ChartKind::Field => {
+            let rows = crate::studies::bench_field::chart_field(out, quick)?;
+            println!(
+                "{}",
+                json!({"charts": [out.join("field_error_vs_cost.svg").display().to_string()], "points": rows})
+            );
+            return Ok(());
+        }
+        ChartKind::Packing => {}
     }
     std::fs::create_dir_all(out)
         .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;

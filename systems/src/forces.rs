@@ -4,11 +4,20 @@
 //! (in `Prepare`) and [`add_contribution`] (in `Accumulate`). The `add` systems are chained in
 //! registration order after [`clear_net_force`], so `NetForce` is summed in the same order on
 //! every run and thread count. Register with [`ForceRegistry::register`].
+//!
+//! Forces that depend on the particle's state and must be re-evaluated wherever a pipeline
+//! needs forces (sub-steps, minimiser iterations) are kernels: see [`kernel`] (re-exported
+//! here).
 
 use bevy_ecs::prelude::*;
 use magsep_components::forces::{ForceContribution, NetForce, NetTorque};
 
 use crate::sets::SimSystems;
+
+pub mod kernel;
+pub use kernel::{
+    Consumption, ExternalForce, ExternalForces, ForceUse, ParticleState, compute_kernel_forces,
+};
 
 /// Zero `NetForce` and `NetTorque` (first system of `Accumulate`).
 pub fn clear_net_force(mut q: Query<(&mut NetForce, &mut NetTorque)>) {

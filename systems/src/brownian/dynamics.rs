@@ -1,8 +1,13 @@
-//! The physics behind the stepper: forces from the [`ForceModel`], mobility (free draining or
-//! a prepared RPY [`Mobility`] over the free particles), hard cores and capture.
+//! The physics behind the stepper: forces from the [`ForceModel`] and the user's external
+//! force kernels ([`ExternalForces`], re-evaluated at every sub-step with the sub-step's
+//! positions and time), mobility (free draining or a prepared RPY [`Mobility`] over the free
+//! particles), hard cores and capture.
 
 use glam::DVec3;
 use magsep_components::brownian::{CaptureEvent, MomentModel};
+use magsep_components::shape::Shape;
+
+use crate::forces::{ExternalForces, ParticleState};
 
 use super::contact::{remove_overlaps, swept_capture};
 use super::hydro::Mobility;
@@ -30,8 +35,22 @@ pub struct PipelineDynamics<'a> {
     pub mobile: Vec<bool>,
     /// Whether captured particles keep exerting pair forces.
     pub captured_interact: bool,
-    /// Forces from contributions outside the model (user plugins), held over the step [N].
+    /// Forces from contributions outside the model and the kernels (a user's
+    /// `ForceContribution` components, accepted only with fixed steps, where no sub-step
+    /// evaluates forces), held over the step [N].
     pub extra: &'a [DVec3],
+    /// External force kernels, evaluated at every drift (None: none registered).
+    pub kernels: Option<&'a ExternalForces>,
+    /// `ParticleId`s and shapes (SI) that the kernels see.
+    pub ids: &'a [u64],
+    /// Shapes [m].
+    pub shapes: &'a [Shape],
+    /// Time at the start of the step [s] and the step dt [s].
+    pub time: (f64, f64),
+    /// Fraction of the step of the next drift evaluation.
+    pub fraction: f64,
+    /// Kernel scratch (force [N], torque [N m]).
+    pub kernel_out: Vec<(DVec3, DVec3)>,
     /// Viscosity [Pa s].
     pub viscosity: f64,
     /// Thermal energy [J].
@@ -106,11 +125,37 @@ impl Dynamics for PipelineDynamics<'_> {
         };
         let mut parts = std::mem::take(&mut self.parts);
         self.model.evaluate(x, &view, &mut parts);
-        let f: Vec<DVec3> = (0..x.len())
+        let mut f: Vec<DVec3> = (0..x.len())
             .map(|i| parts.total(i) + self.extra[i])
             .collect();
         self.parts = parts;
+        if let Some(k) = self.kernels {
+            let t = self.time.0 + self.fraction * self.time.1;
+            let mut out = std::mem::take(&mut self.kernel_out);
+            out.resize(x.len(), (DVec3::ZERO, DVec3::ZERO));
+            let (mobile, ids, shapes) = (&self.mobile, self.ids, self.shapes);
+            k.evaluate_dense(
+                |i| {
+                    mobile[i].then(|| ParticleState {
+                        id: ids[i],
+                        position: x[i],
+                        orientation: glam::DQuat::IDENTITY,
+                        shape: shapes[i],
+                        time: t,
+                    })
+                },
+                &mut out,
+            );
+            for (fi, (fk, _)) in f.iter_mut().zip(&out) {
+                *fi += *fk;
+            }
+            self.kernel_out = out;
+        }
         self.velocities(&f, v);
+    }
+
+    fn at_time(&mut self, t: f64) {
+        self.fraction = t;
     }
 
     fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]) {

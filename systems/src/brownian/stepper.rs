@@ -39,8 +39,12 @@ pub trait Dynamics {
     fn radii(&self) -> &[f64];
     /// Which particles move.
     fn mobile(&self) -> &[bool];
-    /// Deterministic velocities `μ F(x)` [m/s] (zero for fixed particles).
+    /// Deterministic velocities `μ F(x)` [m/s] (zero for fixed particles), at the time set
+    /// by the last [`Dynamics::at_time`].
     fn drift(&mut self, x: &[DVec3], v: &mut [DVec3]);
+    /// The next [`Dynamics::drift`] is evaluated at fraction `t` ∈ [0, 1] of the step (for
+    /// time-dependent forces). Default: ignored.
+    fn at_time(&mut self, _t: f64) {}
     /// Brownian displacements `sqrt(2 k_B T) B w` [m] for Wiener increments `w` [s^½]
     /// (zero for fixed particles). Must be linear in `w`.
     fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]);
@@ -85,6 +89,7 @@ pub fn advance<D: Dynamics>(
     let n = x.len();
     let mut v = v0.unwrap_or_else(|| {
         let mut v = vec![DVec3::ZERO; n];
+        dynamics.at_time(0.0);
         dynamics.drift(x, &mut v);
         stats.force_evaluations += 1;
         v
@@ -132,6 +137,7 @@ pub fn advance<D: Dynamics>(
         dynamics.noise(&wr, &mut br);
         let mut xm: Vec<DVec3> = (0..n).map(|i| x[i] + v[i] * (0.5 * h) + bl[i]).collect();
         dynamics.constrain(x, &mut xm);
+        dynamics.at_time(t_end - 0.5 * h / dt);
         dynamics.drift(&xm, &mut vm);
         stats.force_evaluations += 1;
         let mut x2: Vec<DVec3> = (0..n).map(|i| xm[i] + vm[i] * (0.5 * h) + br[i]).collect();
@@ -171,6 +177,7 @@ pub fn advance<D: Dynamics>(
             dynamics.accept(&xm, &mut x2, t_end);
             *x = x2;
             if !stack.is_empty() {
+                dynamics.at_time(t_end);
                 dynamics.drift(x, &mut v);
                 stats.force_evaluations += 1;
             }

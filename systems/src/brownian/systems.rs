@@ -24,6 +24,8 @@ use super::model::{ForceModel, PairCells, ParticleView};
 use super::pair::Mie;
 use super::stepper::advance;
 use crate::field::CylinderSource;
+use crate::forces::ExternalForces;
+use magsep_components::forces::KernelForce;
 
 /// Dense state of the run in `ParticleId` order (a resource; authoritative during a run, copied
 /// to the components every step).
@@ -35,6 +37,10 @@ pub struct BrownianWorkspace {
     pub positions: Vec<DVec3>,
     /// Radii [m].
     pub radii: Vec<f64>,
+    /// `ParticleId`s.
+    pub ids: Vec<u64>,
+    /// Shapes [m] (what external force kernels see).
+    pub shapes: Vec<Shape>,
     /// Moment laws.
     pub laws: Vec<MomentModel>,
     /// Capture state.
@@ -146,6 +152,7 @@ pub fn init_brownian_workspace(world: &mut World) {
                 m.copied().unwrap_or_default(),
                 c.and_then(|c| c.0),
                 r.0.clone(),
+                *s,
             )
         })
         .collect();
@@ -172,6 +179,8 @@ pub fn init_brownian_workspace(world: &mut World) {
     world.insert_resource(stats);
     world.insert_resource(BrownianWorkspace {
         entities: rows.iter().map(|r| r.1).collect(),
+        ids: rows.iter().map(|r| r.0.0).collect(),
+        shapes: rows.iter().map(|r| r.7).collect(),
         moments: vec![DVec3::ZERO; rows.len()],
         field: vec![DVec3::ZERO; rows.len()],
         laws: rows.iter().map(|r| r.4).collect(),
@@ -320,15 +329,20 @@ type ForceRow<'a> = (
     Option<&'a FieldForce>,
     Option<&'a DipoleForce>,
     Option<&'a ContactForce>,
+    Option<&'a KernelForce>,
 );
 
-/// One step of the stepper from the accumulated forces.
+/// One step of the stepper from the accumulated forces. The step-start drift comes from
+/// `NetForce`; every sub-step re-evaluates the model forces and the external force kernels
+/// (the `KernelForce` part of `NetForce`) at its own positions and time, and holds the rest of
+/// `NetForce` (other registered contributions, accepted with fixed steps only) fixed.
 pub fn integrate_brownian(
     mut ws: ResMut<BrownianWorkspace>,
     config: Res<BrownianConfig>,
     clock: Res<StepClock>,
     mut stats: ResMut<BrownianStats>,
     mut health: ResMut<Health>,
+    kernels: Option<Res<ExternalForces>>,
     forces: Query<ForceRow>,
 ) {
     let ws = &mut *ws;
@@ -336,10 +350,11 @@ pub fn integrate_brownian(
     let mut net = vec![DVec3::ZERO; n];
     let mut extra = vec![DVec3::ZERO; n];
     for (k, e) in ws.entities.iter().enumerate() {
-        if let Ok((f, a, b, c)) = forces.get(*e) {
+        if let Ok((f, a, b, c, kf)) = forces.get(*e) {
             let model = a.map(|v| v.0).unwrap_or_default()
                 + b.map(|v| v.0).unwrap_or_default()
-                + c.map(|v| v.0).unwrap_or_default();
+                + c.map(|v| v.0).unwrap_or_default()
+                + kf.map(|v| v.force).unwrap_or_default();
             net[k] = f.0;
             extra[k] = f.0 - model;
         }
@@ -351,6 +366,12 @@ pub fn integrate_brownian(
         mobile: ws.captured.iter().map(Option::is_none).collect(),
         captured_interact: config.captured_interact,
         extra: &extra,
+        kernels: kernels.as_deref().filter(|k| !k.is_empty()),
+        ids: &ws.ids,
+        shapes: &ws.shapes,
+        time: (clock.time(), clock.dt),
+        fraction: 0.0,
+        kernel_out: Vec::new(),
         viscosity: config.viscosity,
         kt: config.kt(),
         hydro: ws.hydro.as_ref(),

@@ -18,6 +18,7 @@
 use magsep_components::packing::{PackingConfig, PackingStatus, StopReason, VolumeStepRule};
 use rand::Rng;
 
+use super::external::PackingKernels;
 use super::moves::MoveRule;
 use super::neighbour::NeighbourList;
 use super::removal::{RemovalOutcome, remove_overlaps};
@@ -181,15 +182,28 @@ pub fn run_removal(
     list: &mut NeighbourList,
     rng: &mut impl Rng,
 ) -> RemovalOutcome {
+    run_removal_with(p, state, list, rng, None)
+}
+
+/// [`run_removal`] with external force kernels, which only the FIRE rule consumes (the
+/// single-particle rules have no forces; the packing plugin refuses kernels with them).
+pub fn run_removal_with(
+    p: &DriverParams,
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    rng: &mut impl Rng,
+    kernels: Option<&PackingKernels>,
+) -> RemovalOutcome {
     match p.rule {
         MoveRule::Fire => {
             let iterations = p.max_attempts / (state.len().max(1) as u64);
-            super::fire::remove_overlaps_fire(
+            super::fire::remove_overlaps_fire_with(
                 state,
                 list,
                 super::fire::FireParams::default(),
                 p.tolerance,
                 iterations.max(1),
+                kernels,
             )
         }
         rule => remove_overlaps(state, list, rule, p.tolerance, p.max_attempts, rng),

@@ -9,7 +9,7 @@
 
 use glam::{DQuat, DVec3};
 
-use super::state::{Body, BodyKind};
+use super::body::{Body, BodyKind};
 use crate::geometry::segment_closest;
 use crate::geometry::superquadric::{self as sq, ContactOptions, Superquadric};
 

@@ -18,9 +18,21 @@
 //! minimiser but not its minima. Parameters are Bitzek et al.'s (N_min 5, f_inc 1.1,
 //! f_dec 0.5, alpha_0 0.1, f_alpha 0.99) with dt_0 = 0.1, dt_max = 1 (reduced units: D = 1,
 //! unit stiffness, density 1).
+//!
+//! **External forces.** With user force kernels ([`remove_overlaps_fire_with`], units and
+//! scaling in [`super::external`]) FIRE minimises the overlap energy plus the kernels'
+//! potential: their reduced forces and torques are added to the contact forces at every
+//! iteration, and the minimisation ends when no overlap exceeds the tolerance *and* the
+//! largest residual force is below 1 % of the largest external force at the start (the
+//! particles have settled in the potential), or at the iteration budget, where it succeeds if
+//! no overlap exceeds the tolerance (a potential without a minimum, like gravity in a periodic
+//! box, never settles and uses the whole budget). The stagnation test watches the overlap
+//! energy alone and fails only while an overlap exceeds the tolerance. FIRE itself needs no
+//! energy, only forces (the power F·v).
 
 use glam::{DQuat, DVec3};
 
+use super::external::PackingKernels;
 use super::neighbour::NeighbourList;
 use super::removal::{RemovalOutcome, turn_bound};
 use super::state::{BodyKind, PackingState};
@@ -92,6 +104,14 @@ pub fn overlap_forces(
     (max_overlap, energy, fallbacks)
 }
 
+/// Largest residual force or (projected) torque.
+fn residual(f: &[DVec3], t: &[DVec3]) -> f64 {
+    f.iter()
+        .zip(t)
+        .map(|(f, t)| f.length().max(t.length()))
+        .fold(0.0, f64::max)
+}
+
 /// Minimise the overlap energy until no overlap exceeds `tol`, with at most `max_iterations`
 /// FIRE iterations. `attempts` of the outcome = iterations x N.
 pub fn remove_overlaps_fire(
@@ -101,7 +121,22 @@ pub fn remove_overlaps_fire(
     tol: f64,
     max_iterations: u64,
 ) -> RemovalOutcome {
+    remove_overlaps_fire_with(state, list, params, tol, max_iterations, None)
+}
+
+/// [`remove_overlaps_fire`] with external force kernels (see the module documentation).
+pub fn remove_overlaps_fire_with(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    params: FireParams,
+    tol: f64,
+    max_iterations: u64,
+    kernels: Option<&PackingKernels>,
+) -> RemovalOutcome {
     let n = state.len();
+    let (kernel_scale, ext_max) = kernels.map_or((0.0, 0.0), |k| k.scale(state, tol));
+    let kernels = kernels.filter(|_| kernel_scale > 0.0);
+    let mut scratch = Vec::new();
     let mut f = vec![DVec3::ZERO; n];
     let mut t = vec![DVec3::ZERO; n];
     let mut v = vec![DVec3::ZERO; n];
@@ -126,30 +161,11 @@ pub fn remove_overlaps_fire(
     loop {
         list.ensure(state);
         let (max_overlap, energy, fb) = overlap_forces(state, list, &mut f, &mut t);
+        if let Some(k) = kernels {
+            k.add_reduced(state, kernel_scale, &mut scratch, &mut f, &mut t);
+        }
         contacts += pairs_per_eval(list);
         fallbacks += fb;
-        let outcome = |success: bool, it: u64| RemovalOutcome {
-            success,
-            attempts: it * n as u64,
-            sweeps: it,
-            contacts,
-            fallbacks,
-        };
-        if max_overlap <= tol {
-            return outcome(true, it);
-        }
-        // A jammed configuration relaxes to a minimum with finite energy: when the energy has
-        // fallen by less than 2 % over the last STAGNATION_WINDOW iterations, give up early.
-        if it % STAGNATION_WINDOW == 0 {
-            if it > 0 && energy > 0.98 * window_energy {
-                return outcome(false, it);
-            }
-            window_energy = energy;
-        }
-        if it >= max_iterations {
-            return outcome(false, it);
-        }
-        it += 1;
         for i in 0..n {
             if !rotates[i] {
                 t[i] = DVec3::ZERO;
@@ -159,6 +175,29 @@ pub fn remove_overlaps_fire(
                 t[i] -= along * a; // spin about the axis moves nothing
             }
         }
+        let outcome = |success: bool, it: u64| RemovalOutcome {
+            success,
+            attempts: it * n as u64,
+            sweeps: it,
+            contacts,
+            fallbacks,
+        };
+        let settled = kernels.is_none() || residual(&f, &t) <= 0.01 * ext_max;
+        if max_overlap <= tol && settled {
+            return outcome(true, it);
+        }
+        // A jammed configuration relaxes to a minimum with finite energy: when the energy has
+        // fallen by less than 2 % over the last STAGNATION_WINDOW iterations, give up early.
+        if it % STAGNATION_WINDOW == 0 {
+            if it > 0 && energy > 0.98 * window_energy && max_overlap > tol {
+                return outcome(false, it);
+            }
+            window_energy = energy;
+        }
+        if it >= max_iterations {
+            return outcome(kernels.is_some() && max_overlap <= tol, it);
+        }
+        it += 1;
         // FIRE mixing on the global (translation + rotation) velocity vector
         let (mut p, mut vv, mut ff) = (0.0, 0.0, 0.0);
         for i in 0..n {

@@ -1,12 +1,15 @@
 //! The mechanical contraction method (MCM) for random dense packings (thesis 000, ch. 2-3).
 //!
-//! Kernels on dense arrays in reduced units ([`state`]): contacts ([`contact`]), the Verlet
+//! Kernels on dense arrays in reduced units ([`state`], bodies in [`body`]): contacts
+//! ([`contact`]), user force kernels in reduced units ([`external`]), the Verlet
 //! list over all periodic images ([`neighbour`]), the move rules ([`moves`]), overlap-removal
 //! sweeps ([`removal`]), the compression driver ([`compress`]), random insertion ([`insert`]).
 //! The ECS glue is in [`systems`].
 
+pub mod body;
 pub mod compress;
 pub mod contact;
+pub mod external;
 pub mod fire;
 pub mod insert;
 pub mod moves;

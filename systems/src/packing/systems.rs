@@ -12,6 +12,7 @@ use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
+use super::external::PackingKernels;
 use super::compress::{DriverParams, compress, next_volume_step, settle_step};
 use super::neighbour::NeighbourList;
 use super::removal::RemovalOutcome;
@@ -20,6 +21,7 @@ use super::walls::WallKind;
 use crate::analysis::cubatic::cubatic_order;
 use crate::analysis::wall_order::aligned_fraction;
 use crate::analysis::{contact_numbers, nematic_order};
+use crate::forces::ExternalForces;
 use crate::rng::{DRIVER_STREAM, particle_stream};
 
 /// Dense working copy of the packing, in reduced units; the source of truth within a step.
@@ -39,6 +41,10 @@ pub struct McmWorkspace {
     pub reference_diameter: f64,
     /// Particle entities in `ParticleId` order.
     pub entities: Vec<Entity>,
+    /// `ParticleId`s in dense order.
+    pub ids: Vec<u64>,
+    /// SI shapes in dense order (what external force kernels see).
+    pub shapes: Vec<Shape>,
     /// Volume step of the current step / D^3.
     pub current_volume_step: f64,
     /// Outcome of the current step's overlap removal.
@@ -68,6 +74,7 @@ pub fn init_mcm_workspace(world: &mut World) {
     let shapes: Vec<Shape> = rows.iter().map(|r| r.4).collect();
     let state = state_from_si(&container, &positions, &orientations, &shapes, d);
     let params = DriverParams::from_config(&config, d);
+    let shapes = shapes.clone();
     let mut status = super::compress::initial_status(&params, &state);
     if let Some(old) = world.get_resource::<PackingStatus>() {
         // resuming: keep counters and step sizes
@@ -85,6 +92,8 @@ pub fn init_mcm_workspace(world: &mut World) {
             .unwrap_or_else(|| particle_stream(seed, DRIVER_STREAM)),
         reference_diameter: d,
         entities: rows.iter().map(|r| r.1).collect(),
+        ids: rows.iter().map(|r| r.0.0).collect(),
+        shapes,
         current_volume_step: 0.0,
         outcome: None,
     });
@@ -162,18 +171,33 @@ pub fn begin_compression_step(mut ws: ResMut<McmWorkspace>, status: Res<PackingS
     compress(&mut ws.state, &mut ws.list, dv);
 }
 
-/// Constraints: remove overlaps within the attempt budget.
-pub fn remove_overlaps_mcm(mut ws: ResMut<McmWorkspace>, status: Res<PackingStatus>) {
+/// Constraints: remove overlaps within the attempt budget (FIRE: with the registered
+/// external force kernels, see [`super::external`]).
+pub fn remove_overlaps_mcm(
+    mut ws: ResMut<McmWorkspace>,
+    status: Res<PackingStatus>,
+    kernels: Option<Res<ExternalForces>>,
+    clock: Option<Res<StepClock>>,
+) {
     if status.stopped.is_some() {
         return;
     }
     let ws = &mut *ws;
     let p = ws.params;
-    ws.outcome = Some(super::compress::run_removal(
+    let kernels = kernels.as_deref().filter(|k| !k.is_empty());
+    let packing_kernels = kernels.map(|k| PackingKernels {
+        kernels: k,
+        d: ws.reference_diameter,
+        shapes: &ws.shapes,
+        ids: &ws.ids,
+        time: clock.as_ref().map(|c| c.time()).unwrap_or(0.0),
+    });
+    ws.outcome = Some(super::compress::run_removal_with(
         &p,
         &mut ws.state,
         &mut ws.list,
         &mut ws.rng,
+        packing_kernels.as_ref(),
     ));
 }
 

@@ -1,13 +1,13 @@
 //! The `/scene` channel: one `foxglove.SceneUpdate` per frame.
 
-use super::{BackdropCube, FibreShape, ParticleFrame, SCENE_FRAME_ID};
+use crate::frame::WallShape as Walls;
+use crate::{BackdropCube, FibreShape, ParticleFrame, SCENE_FRAME_ID};
 use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, Duration, LinePrimitive, Point3, Pose, Quaternion,
     SceneEntity, SceneUpdate, SpherePrimitive, Timestamp, TriangleListPrimitive, Vector3,
     line_primitive,
 };
 use glam::{DQuat, DVec3};
-use magsep_components::container::Walls;
 
 /// Entity id of the particles.
 pub(crate) const PARTICLES_ENTITY: &str = "particles";

@@ -1,16 +1,22 @@
-//! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame.
+//! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame, and the channels and
+//! metadata records that plugins add.
 
-use super::frame::{BackdropCube, FibreShape};
-use super::proto::{ParticleState, particle_count, state_schema};
-use super::scene::{SceneDecor, scene_update};
-use super::{
+mod channels;
+
+pub use channels::ChannelHandle;
+
+use crate::frame::{BackdropCube, FibreShape, WallShape};
+use crate::meta::metadata_entries;
+use crate::proto::{encode_state, particle_count, state_schema};
+use crate::scene::{SceneDecor, scene_update};
+use crate::{
     METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
     SUMMARY_METADATA_NAME,
 };
+use channels::AddedChannel;
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
 use glam::DVec3;
-use magsep_components::container::Walls;
 use mcap::records::{MessageHeader, Metadata};
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -43,11 +49,14 @@ pub fn log_time_ns(frame: &ParticleFrame) -> u64 {
 }
 
 /// Writes a recording: MCAP with zstd-compressed chunks, channels [`STATE_TOPIC`] and
-/// [`SCENE_TOPIC`], metadata records [`METADATA_NAME`] and [`SUMMARY_METADATA_NAME`].
+/// [`SCENE_TOPIC`], metadata records [`METADATA_NAME`] and [`SUMMARY_METADATA_NAME`], plus the
+/// channels ([`add_channel`](Self::add_channel)) and metadata records
+/// ([`add_metadata`](Self::add_metadata)) that plugins add.
 ///
-/// Every call that writes data ends the current chunk and flushes the file, so a process killed
-/// at any point leaves a file whose finished frames [`read_recording`](super::read_recording)
-/// recovers. [`finish`](Self::finish) writes the summary section and footer; dropping an
+/// Every call that writes data (a frame, a message or a batch of messages, a metadata record,
+/// a channel) ends the current chunk and flushes the file, so a process killed at any point
+/// leaves a file whose finished frames and messages [`read_recording`](crate::read_recording)
+/// and [`RecordingReader`](crate::RecordingReader) recover. [`finish`](Self::finish) writes the summary section and footer; dropping an
 /// unfinished writer does the same on a best-effort basis (errors are ignored, nothing panics).
 ///
 /// The writer is `Send + Sync` (checked at compile time) so that it can live in a bevy_ecs
@@ -64,13 +73,16 @@ pub struct RecordingWriter {
     buf: Vec<u8>,
     /// Fibres, walls and particle shapes drawn in every scene update.
     decor: SceneDecor,
+    /// Channels added by plugins, in the order added.
+    channels: Vec<AddedChannel>,
 }
 
 impl RecordingWriter {
     /// Creates (or truncates) the file at `path`, writes the MCAP header, the schemas and
     /// channels, and the metadata record [`METADATA_NAME`] with keys `scene_text` (verbatim),
-    /// `seed` (decimal), `version`, `pipeline`, `dt` (seconds, shortest round-trip decimal) and
-    /// `schedule` (JSON object: set name -> system names), then flushes the file.
+    /// `seed` (decimal), `version`, `pipeline`, `dt` (seconds, shortest round-trip decimal),
+    /// `schedule` (JSON object: set name -> system names), `plugins` (JSON array of
+    /// `{"name", "params"}`) and `extra` (JSON object of strings), then flushes the file.
     pub fn create(path: &Path, meta: &RecordingMetadata) -> Result<Self, RecordError> {
         let file = File::create(path).map_err(|source| RecordError::Io {
             path: path.to_path_buf(),
@@ -78,7 +90,7 @@ impl RecordingWriter {
         })?;
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
-            .library(format!("magsep-plugins/{}", env!("CARGO_PKG_VERSION")))
+            .library(format!("magsep-record/{}", env!("CARGO_PKG_VERSION")))
             // Chunks end at every flush, i.e. once per frame.
             .chunk_size(None);
         let mut writer = Self {
@@ -90,6 +102,7 @@ impl RecordingWriter {
             last_log_time: None,
             buf: Vec::new(),
             decor: SceneDecor::default(),
+            channels: Vec::new(),
         };
         let mut mcap = options
             .create(BufWriter::new(file))
@@ -116,19 +129,8 @@ impl RecordingWriter {
             .map_err(|e| writer.write_error(e))?;
         writer.mcap = Some(mcap);
 
-        let schedule =
-            serde_json::to_string(&meta.schedule).map_err(|e| RecordError::InvalidInput {
-                detail: format!("schedule is not serialisable as JSON: {e}"),
-            })?;
-        let entries = [
-            ("scene_text", meta.scene_text.clone()),
-            ("seed", meta.seed.to_string()),
-            ("version", meta.version.clone()),
-            ("pipeline", meta.pipeline.clone()),
-            ("dt", format!("{:?}", meta.dt)),
-            ("schedule", schedule),
-        ];
-        writer.write_metadata(METADATA_NAME, &entries)?;
+        let entries = metadata_entries(meta)?;
+        writer.write_metadata(METADATA_NAME, entries)?;
         Ok(writer)
     }
 
@@ -171,12 +173,8 @@ impl RecordingWriter {
         let sequence = self.frames_written as u32;
 
         self.buf.clear();
-        ParticleState::from_frame(frame)
-            .encode(&mut self.buf)
-            .map_err(|e| RecordError::InvalidInput {
-                detail: format!("encoding /state: {e}"),
-            })?;
-        self.write_message(self.state_channel, sequence, log_time)?;
+        encode_state(frame, &mut self.buf);
+        self.write_buf(self.state_channel, sequence, log_time)?;
 
         self.buf.clear();
         scene_update(frame, colours, &self.decor, log_time)
@@ -184,7 +182,7 @@ impl RecordingWriter {
             .map_err(|e| RecordError::InvalidInput {
                 detail: format!("encoding /scene: {e}"),
             })?;
-        self.write_message(self.scene_channel, sequence, log_time)?;
+        self.write_buf(self.scene_channel, sequence, log_time)?;
 
         self.flush()?;
         self.last_log_time = Some(log_time);
@@ -198,9 +196,11 @@ impl RecordingWriter {
     }
 
     /// Hard walls to draw (entity `walls`, sized from each frame's box edges) in every
-    /// following scene update.
-    pub fn set_walls(&mut self, walls: Option<Walls>) {
-        self.decor.walls = walls;
+    /// following scene update: a [`WallShape`], or any value that serialises like one (e.g.
+    /// `magsep_components::container::Walls`, whose serde form is the same; this keeps the codec
+    /// free of ECS types). A value of another form draws no walls.
+    pub fn set_walls<W: serde::Serialize>(&mut self, walls: Option<W>) {
+        self.decor.walls = walls.and_then(|w| WallShape::from_serialize(&w));
     }
 
     /// Boxes to draw behind the particles (entity `backdrop`) in every following scene update.
@@ -223,7 +223,8 @@ impl RecordingWriter {
                 detail: format!("summary is not valid JSON: {e}"),
             }
         })?;
-        self.write_metadata(SUMMARY_METADATA_NAME, &[("summary", summary_json.into())])
+        let entries = BTreeMap::from([("summary".to_string(), summary_json.to_string())]);
+        self.write_metadata(SUMMARY_METADATA_NAME, entries)
     }
 
     /// Writes the summary section (schemas, channels, statistics, indexes) and the footer,
@@ -240,13 +241,14 @@ impl RecordingWriter {
         file.sync_all().map_err(|e| self.io_error(e))
     }
 
-    fn mcap(&mut self) -> &mut McapWriter {
+    pub(crate) fn mcap(&mut self) -> &mut McapWriter {
         self.mcap
             .as_mut()
             .expect("RecordingWriter holds its MCAP writer until finish() consumes it")
     }
 
-    fn write_message(&mut self, channel: u16, sequence: u32, time: u64) -> Result<(), RecordError> {
+    /// Writes `self.buf` as one message (no flush).
+    fn write_buf(&mut self, channel: u16, sequence: u32, time: u64) -> Result<(), RecordError> {
         let header = MessageHeader {
             channel_id: channel,
             sequence,
@@ -259,17 +261,14 @@ impl RecordingWriter {
         result.map_err(|e| self.write_error(e))
     }
 
-    fn write_metadata(
+    pub(crate) fn write_metadata(
         &mut self,
         name: &str,
-        entries: &[(&str, String)],
+        entries: BTreeMap<String, String>,
     ) -> Result<(), RecordError> {
         let metadata = Metadata {
             name: name.into(),
-            metadata: entries
-                .iter()
-                .map(|(k, v)| ((*k).to_string(), v.clone()))
-                .collect(),
+            metadata: entries,
         };
         let result = self.mcap().write_metadata(&metadata);
         result.map_err(|e| self.write_error(e))?;
@@ -277,12 +276,12 @@ impl RecordingWriter {
     }
 
     /// Ends the current chunk and flushes the `BufWriter` to the file (see `mcap::Writer::flush`).
-    fn flush(&mut self) -> Result<(), RecordError> {
+    pub(crate) fn flush(&mut self) -> Result<(), RecordError> {
         let result = self.mcap().flush();
         result.map_err(|e| self.write_error(e))
     }
 
-    fn write_error(&self, source: mcap::McapError) -> RecordError {
+    pub(crate) fn write_error(&self, source: mcap::McapError) -> RecordError {
         RecordError::Write {
             path: self.path.clone(),
             source,
@@ -313,6 +312,7 @@ impl std::fmt::Debug for RecordingWriter {
         f.debug_struct("RecordingWriter")
             .field("path", &self.path)
             .field("frames_written", &self.frames_written)
+            .field("channels", &self.channels.len())
             .field("finished", &self.mcap.is_none())
             .finish()
     }

@@ -1,7 +1,11 @@
 //! Tests of the recording format: round trips, truncation, corruption, interoperability.
 
-use super::proto::{ParticleStateWire, state_schema};
-use super::*;
+mod channels;
+mod damage;
+mod stream;
+
+use crate::proto::{ParticleStateWire, state_schema};
+use crate::*;
 use foxglove::Decode;
 use foxglove::messages::SceneUpdate;
 use foxglove::prost_types::FileDescriptorSet;
@@ -14,10 +18,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// A file under the system temp dir, removed on drop.
-pub(super) struct TempFile(PathBuf);
+pub(crate) struct TempFile(PathBuf);
 
 impl TempFile {
-    pub(super) fn new(name: &str) -> Self {
+    pub(crate) fn new(name: &str) -> Self {
         let dir = std::env::temp_dir().join("magsep-record-tests");
         std::fs::create_dir_all(&dir).unwrap();
         Self(dir.join(format!("{}-{name}", std::process::id())))
@@ -54,7 +58,7 @@ fn any_f64(rng: &mut Xoshiro256PlusPlus) -> f64 {
 }
 
 /// Frames with random bits in every field; `physical` gives times `step * dt`, else 0.
-pub(super) fn random_frames(seed: u64, count: usize, physical: bool) -> Vec<ParticleFrame> {
+pub(crate) fn random_frames(seed: u64, count: usize, physical: bool) -> Vec<ParticleFrame> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     (0..count)
         .map(|k| {
@@ -96,7 +100,7 @@ pub(super) fn random_frames(seed: u64, count: usize, physical: bool) -> Vec<Part
         .collect()
 }
 
-pub(super) fn metadata() -> RecordingMetadata {
+pub(crate) fn metadata() -> RecordingMetadata {
     let mut schedule = BTreeMap::new();
     schedule.insert("Forces".to_string(), vec!["gravity".into(), "wca".into()]);
     schedule.insert("Integrate".to_string(), vec!["euler_maruyama".into()]);
@@ -107,13 +111,24 @@ pub(super) fn metadata() -> RecordingMetadata {
         pipeline: "brownian".into(),
         schedule,
         dt: 0.1 + 0.2,
+        plugins: vec![
+            PluginInfo {
+                name: "brownian_forces".into(),
+                params: serde_json::json!({"temperature_k": 293.15, "fibre_radius_m": 1e-5}),
+            },
+            PluginInfo {
+                name: "record".into(),
+                params: serde_json::Value::Null,
+            },
+        ],
+        extra: BTreeMap::from([("capture.rule".into(), "touch ✓".into())]),
     }
 }
 
 const SUMMARY: &str = r#"{"steps": 1000, "accepted": 0.5}"#;
 
 /// Writes a finished recording of `frames` to a temp file and returns its bytes.
-pub(super) fn write_recording(
+pub(crate) fn write_recording(
     name: &str,
     frames: &[ParticleFrame],
     summary: bool,
@@ -133,7 +148,7 @@ pub(super) fn write_recording(
 }
 
 /// Equality of frames comparing every float bit for bit.
-pub(super) fn bits(f: &ParticleFrame) -> Vec<u64> {
+pub(crate) fn bits(f: &ParticleFrame) -> Vec<u64> {
     let mut out = vec![f.step, f.time.to_bits()];
     out.extend(f.box_edges.to_array().map(f64::to_bits));
     out.extend(&f.ids);
@@ -154,7 +169,7 @@ pub(super) fn bits(f: &ParticleFrame) -> Vec<u64> {
     out
 }
 
-pub(super) fn assert_frames_bitwise_eq(a: &[ParticleFrame], b: &[ParticleFrame]) {
+pub(crate) fn assert_frames_bitwise_eq(a: &[ParticleFrame], b: &[ParticleFrame]) {
     assert_eq!(a.len(), b.len(), "frame counts differ");
     for (i, (x, y)) in a.iter().zip(b).enumerate() {
         assert_eq!(
@@ -206,17 +221,20 @@ fn record_channels_are_listed_with_counts() {
     let frames = random_frames(11, 9, true);
     let (path, _) = write_recording("channels.mcap", &frames, false);
     let rec = read_recording(&path).unwrap();
-    let expect = |topic: &str, schema: &str| ChannelInfo {
+    let expect = |id: u16, topic: &str, schema: &str| ChannelInfo {
+        id,
         topic: topic.into(),
         schema_name: schema.into(),
+        schema_encoding: "protobuf".into(),
         message_encoding: "protobuf".into(),
         message_count: 9,
     };
+    let ids: Vec<u16> = rec.channels.iter().map(|c| c.id).collect();
     assert_eq!(
         rec.channels,
         vec![
-            expect(STATE_TOPIC, STATE_SCHEMA_NAME),
-            expect(SCENE_TOPIC, "foxglove.SceneUpdate")
+            expect(ids[0], STATE_TOPIC, STATE_SCHEMA_NAME),
+            expect(ids[1], SCENE_TOPIC, "foxglove.SceneUpdate")
         ]
     );
 }
@@ -516,7 +534,7 @@ fn record_scene_draws_the_backdrop() {
         status_json: "{}".into(),
     };
     let decor = scene::SceneDecor {
-        backdrop: vec![crate::record::BackdropCube {
+        backdrop: vec![crate::BackdropCube {
             center: DVec3::new(0.5, 0.5, 0.25),
             size: DVec3::new(1.0, 1.0, 0.5),
             colour: [0.9, 0.3, 0.2, 0.1],

@@ -1,4 +1,8 @@
-//! Recording of simulation runs to MCAP files, and reading them back.
+//! # magsep-record
+//!
+//! The MCAP codec of magsep recordings: writing simulation runs to MCAP files, and reading them
+//! back. No ECS types: the simulation side (`magsep-plugins`) re-exports this crate as
+//! `magsep_plugins::record`.
 //!
 //! A recording is an [MCAP](https://mcap.dev) file with zstd-compressed chunks and two channels:
 //!
@@ -8,12 +12,22 @@
 //! * [`SCENE_TOPIC`] (`/scene`): a `foxglove.SceneUpdate` per frame (true-size spheres, capsules
 //!   and the periodic box in frame `world`), so that the file opens in Foxglove as is.
 //!
-//! The run's [`RecordingMetadata`] is stored as the MCAP metadata record [`METADATA_NAME`]
-//! (`magsep`) right after the file header, and an optional JSON summary as the metadata record
+//! Plugins add channels of their own ([`RecordingWriter::add_channel`],
+//! [`RecordingWriter::add_protobuf_channel`] with a self-describing schema from
+//! [`protobuf_schema`]) and metadata records ([`RecordingWriter::add_metadata`]).
+//!
+//! The run's [`RecordingMetadata`] (scene, seed, schedule, the plugins and their parameters,
+//! extra key/values) is stored as the MCAP metadata record [`METADATA_NAME`] (`magsep`) right
+//! after the file header, and an optional JSON summary as the metadata record
 //! [`SUMMARY_METADATA_NAME`] (`magsep.summary`). The writer ends a chunk and flushes the file after
-//! every frame, so a process killed mid-run leaves every finished frame readable; the reader
-//! reports such a file through [`Recording::truncated`]. `recordings/README.md` documents the
-//! format for other readers.
+//! every frame and every message batch, so a process killed mid-run leaves every finished frame
+//! and message readable; the readers report such a file through [`Recording::truncated`] and
+//! [`RecordingReader::truncated`]. `recordings/README.md` documents the format for other
+//! readers.
+//!
+//! [`RecordingReader`] streams any channel of a file chunk by chunk (through the summary's
+//! indexes when present) with bounded memory; [`read_recording`] reads a whole file into a
+//! [`Recording`] on top of it.
 //!
 //! Lengths are in metres and times in seconds throughout; MCAP log times are in nanoseconds
 //! (see [`log_time_ns`]).
@@ -21,13 +35,13 @@
 //! # Example
 //!
 //! ```no_run
-//! use magsep_plugins::record::{
+//! use magsep_record::{
 //!     ParticleFrame, RecordingMetadata, RecordingWriter, read_recording,
 //! };
 //! use glam::{DQuat, DVec3};
 //! use std::path::Path;
 //!
-//! # fn main() -> Result<(), magsep_plugins::record::RecordError> {
+//! # fn main() -> Result<(), magsep_record::RecordError> {
 //! let path = Path::new("out/run.mcap");
 //! let meta = RecordingMetadata {
 //!     scene_text: "# scene file text".into(),
@@ -64,22 +78,28 @@
 #![warn(missing_docs)]
 
 pub mod frame;
+mod meta;
 mod parse;
 mod proto;
 pub mod reader;
 mod scene;
+pub mod schema;
 pub mod writer;
 
-#[cfg(test)]
-mod damage_tests;
 #[cfg(test)]
 mod tests;
 
 use std::path::PathBuf;
 
-pub use frame::{BackdropCube, FibreShape, ParticleFrame, RecordingMetadata};
-pub use reader::{ChannelInfo, Recording, read_recording, read_recording_bytes};
-pub use writer::{RecordingWriter, log_time_ns};
+pub use frame::{
+    BackdropCube, FibreShape, ParticleFrame, PluginInfo, RecordingMetadata, WallShape,
+};
+pub use reader::{
+    ChannelInfo, Frames, Messages, MetadataRecord, RawMessage, ReadMode, ReaderLimits, Recording,
+    RecordingReader, SchemaInfo, read_recording, read_recording_bytes,
+};
+pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
+pub use writer::{ChannelHandle, RecordingWriter, log_time_ns};
 
 /// Topic of the lossless particle state channel (schema `magsep.ParticleState`).
 pub const STATE_TOPIC: &str = "/state";

@@ -1,5 +1,5 @@
-//! Data exchanged with recordings: one frame of particle state, and the run's metadata.
-//! Lengths in metres, time in seconds.
+//! Data exchanged with recordings: one frame of particle state, the run's metadata, and what
+//! the scene draws besides the particles. Lengths in metres, time in seconds.
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -71,4 +71,52 @@ pub struct RecordingMetadata {
     pub schedule: BTreeMap<String, Vec<String>>,
     /// Time step \[s\] (0 for packing).
     pub dt: f64,
+    /// The schedule's plugins and their parameters, in build order (empty when read from a
+    /// file written before this field existed).
+    #[serde(default)]
+    pub plugins: Vec<PluginInfo>,
+    /// Metadata that plugins add, key -> value (empty when read from an older file).
+    #[serde(default)]
+    pub extra: BTreeMap<String, String>,
+}
+
+/// A plugin of the run's schedule and its parameters (in [`RecordingMetadata::plugins`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PluginInfo {
+    /// Plugin name, e.g. `brownian_forces`.
+    pub name: String,
+    /// Its parameters as JSON (SI units: lengths in metres, times in seconds, as in the scene
+    /// file); `null` when it has none.
+    #[serde(default)]
+    pub params: serde_json::Value,
+}
+
+/// Hard-wall geometry drawn in the scene (entity `walls`), in the coordinates of the box
+/// `[0, edges]` of each frame. Its serde form is that of `magsep_components::container::Walls`
+/// (`"Cylinder"`, `{"Wedge": {"angle": rad}}`, `"Slab"`, `"Box"`), which
+/// [`RecordingWriter::set_walls`](crate::RecordingWriter::set_walls) relies on to accept either.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum WallShape {
+    /// A cylinder wall of radius `edges.x / 2` about the axis through (edges.x/2, edges.y/2),
+    /// along z.
+    Cylinder,
+    /// A right wedge prism: bottom plane y = 0, back plane x = edges.x, slope plane through the
+    /// z axis.
+    Wedge {
+        /// Acute angle between the bottom and the slope \[rad\].
+        angle: f64,
+    },
+    /// Two walls z = 0 and z = edges.z.
+    Slab,
+    /// Six walls (drawn as the box outline).
+    Box,
+}
+
+impl WallShape {
+    /// The shape of any value that serialises like a [`WallShape`]; `None` otherwise.
+    pub fn from_serialize<W: Serialize>(walls: &W) -> Option<Self> {
+        serde_json::to_value(walls)
+            .ok()
+            .and_then(|v| serde_json::from_value(v).ok())
+    }
 }

@@ -1,9 +1,7 @@
 //! Tests of damaged recordings: killed writers, cut files, corrupt and fuzzed bytes.
 
-use super::tests::{
-    TempFile, assert_frames_bitwise_eq, bits, metadata, random_frames, write_recording,
-};
-use super::*;
+use super::{TempFile, assert_frames_bitwise_eq, bits, metadata, random_frames, write_recording};
+use crate::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::{Rng, SeedableRng};
 

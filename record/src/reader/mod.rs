@@ -1,0 +1,110 @@
+//! Reading recordings back: the streaming [`RecordingReader`], and [`read_recording`], which
+//! reads a whole file into a [`Recording`] on top of it.
+
+mod chunk;
+mod layout;
+mod scan;
+mod source;
+mod stream;
+mod summary;
+
+pub use chunk::ReaderLimits;
+pub use layout::MetadataRecord;
+pub use stream::{Frames, Messages, RawMessage, ReadMode, RecordingReader, SchemaInfo};
+
+use crate::{ParticleFrame, RecordError, RecordingMetadata};
+use std::io::{Read, Seek};
+use std::path::Path;
+
+/// A channel of a recording, with the number of messages on it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChannelInfo {
+    /// Channel id in the file.
+    pub id: u16,
+    /// Topic, e.g. `/state`.
+    pub topic: String,
+    /// Name of the channel's schema, e.g. `magsep.ParticleState` (empty if it has none).
+    pub schema_name: String,
+    /// Encoding of the channel's schema, e.g. `protobuf` (empty if it has none).
+    pub schema_encoding: String,
+    /// Message encoding, e.g. `protobuf`.
+    pub message_encoding: String,
+    /// Number of messages on the channel (complete messages read, for a file cut short).
+    pub message_count: u64,
+}
+
+/// Everything read from a recording.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Recording {
+    /// The run's metadata (record `magsep`), if present.
+    pub metadata: Option<RecordingMetadata>,
+    /// All complete `/state` frames, in file order.
+    pub frames: Vec<ParticleFrame>,
+    /// The JSON text of the last `magsep.summary` record, if any.
+    pub summary_json: Option<String>,
+    /// The channels, in channel-id order.
+    pub channels: Vec<ChannelInfo>,
+    /// All metadata records in file order (`magsep`, `magsep.summary`, plugins' records).
+    pub metadata_records: Vec<MetadataRecord>,
+    /// `None` for a complete, intact file. Otherwise why reading stopped early: the file ends
+    /// before its footer (process killed; the message gives the byte where the file ends and
+    /// the start of the incomplete record), or a damaged record follows the frames read.
+    pub truncated: Option<String>,
+    /// Size of the file (bytes).
+    pub file_bytes: u64,
+}
+
+/// Reads the recording at `path`: metadata, all complete frames, summary and channel list.
+///
+/// The file is scanned linearly ([`ReadMode::Linear`]), checking every CRC, and streamed: only
+/// one chunk is in memory at a time besides the frames returned. A file cut short (no footer)
+/// gives `Ok` with the frames read and [`Recording::truncated`] set. Data that is not MCAP
+/// gives [`RecordError::NotMcap`]; a damaged record gives [`RecordError::Corrupt`] or
+/// [`RecordError::Decode`] with its byte offset, unless frames were read before it, in which
+/// case they are returned with the error in [`Recording::truncated`]. Never panics.
+pub fn read_recording(path: &Path) -> Result<Recording, RecordError> {
+    let reader = RecordingReader::open_with(path, ReadMode::Linear, ReaderLimits::default())?;
+    collect(reader)
+}
+
+/// Like [`read_recording`], on the bytes of a recording already in memory.
+pub fn read_recording_bytes(data: &[u8]) -> Result<Recording, RecordError> {
+    let reader = RecordingReader::from_reader(
+        std::io::Cursor::new(data),
+        Path::new("<memory>"),
+        ReadMode::Linear,
+        ReaderLimits::default(),
+    )?;
+    collect(reader)
+}
+
+fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, RecordError> {
+    let mut frames = Vec::new();
+    let mut failure = None;
+    for frame in reader.frames() {
+        match frame {
+            Ok(f) => frames.push(f),
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        }
+    }
+    let n = frames.len();
+    let truncated = match failure {
+        None => reader.truncated().map(str::to_string),
+        Some(e) if n == 0 => return Err(e),
+        Some(e) => Some(format!(
+            "{e}; reading stopped there: {n} complete frames read"
+        )),
+    };
+    Ok(Recording {
+        metadata: reader.metadata().cloned(),
+        frames,
+        summary_json: reader.summary_json().map(str::to_string),
+        channels: reader.channels(),
+        metadata_records: reader.metadata_records().to_vec(),
+        truncated,
+        file_bytes: reader.file_bytes(),
+    })
+}
