@@ -65,4 +65,3 @@ pub use toml;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/writing-a-plugin.md")]
 pub struct PluginGuideDoctests;
-

@@ -10,7 +10,9 @@ use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
-use magsep_plugins::record::{FibreShape, RecordError, RecordingMetadata, RecordingWriter};
+use magsep_plugins::record::{
+    FibreShape, PluginInfo, RecordError, RecordingMetadata, RecordingWriter,
+};
 use magsep_plugins::recorder::{Recorder, record_now};
 use serde_json::Value;
 
@@ -252,6 +254,12 @@ fn open_recording(
         pipeline: pipeline.name().into(),
         schedule: app.resolved_schedule(),
         dt: app.world.resource::<StepClock>().dt,
+        plugins: app
+            .plugin_infos()
+            .into_iter()
+            .map(|(name, params)| PluginInfo { name, params })
+            .collect(),
+        extra: Default::default(),
     };
     let mut writer = RecordingWriter::create(path, &meta)?;
     let mut fibres: Vec<_> = app

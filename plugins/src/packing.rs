@@ -78,13 +78,13 @@ impl SimPlugin for McmOverlapRemovalPlugin {
 pub fn packing_force_use(scheme: OverlapRemovalScheme) -> ForceUse {
     let kernels = match scheme {
         OverlapRemovalScheme::Fire => Consumption::Consumed,
-        OverlapRemovalScheme::Original | OverlapRemovalScheme::Revised => Consumption::Refused(
-            format!(
+        OverlapRemovalScheme::Original | OverlapRemovalScheme::Revised => {
+            Consumption::Refused(format!(
                 "the packing scheme {scheme:?} (the thesis's single-particle MCM moves) has no \
                  forces; use scheme = \"fire\", which minimises the overlap energy together \
                  with the kernels' potential"
-            ),
-        ),
+            ))
+        }
     };
     ForceUse {
         builtin: Vec::new(),

@@ -137,7 +137,10 @@ fn stiff_trap_kernel_is_stable_with_adaptive_steps_and_boltzmann_variance() {
     let ratio = var / (kt / k);
     eprintln!("stiff trap: <x²> / (kT/k) = {ratio:.4}, max |x| = {max:.3e} m, {stats:?}");
     assert!(health.is_empty(), "{health:?}");
-    assert!(stats.rejections > 0 && stats.depth_limit_hits == 0, "{stats:?}");
+    assert!(
+        stats.rejections > 0 && stats.depth_limit_hits == 0,
+        "{stats:?}"
+    );
     assert!((ratio - 1.0).abs() < 0.05, "<x²> / (kT/k) = {ratio}");
     // and the sub-steps are what keeps it stable: the fixed step blows up
     let (var, _, _, _) = trap_variance(k, 200, 1e-4, 5, 1, StepControl::Fixed);

@@ -124,7 +124,10 @@ fn forces_nobody_consumes_are_refused_with_a_reason() {
     let mut app = SimApp::new();
     app.register_force::<PushForce>();
     let err = app.finish().unwrap_err().0;
-    assert!(err.contains("PushForce") && err.contains("ForceUse"), "{err}");
+    assert!(
+        err.contains("PushForce") && err.contains("ForceUse"),
+        "{err}"
+    );
 
     let mut app = SimApp::new();
     app.add_external_force("trap", Arc::new(Trap(1.0)));
@@ -133,7 +136,10 @@ fn forces_nobody_consumes_are_refused_with_a_reason() {
 
     let mut app = SimApp::new();
     app.add_plugin(&CorePlugin);
-    assert!(app.finish().is_ok(), "nothing registered: nothing to refuse");
+    assert!(
+        app.finish().is_ok(),
+        "nothing registered: nothing to refuse"
+    );
 }
 
 /// A plugin with a parameter (several configured instances in one group).

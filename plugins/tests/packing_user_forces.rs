@@ -74,9 +74,7 @@ fn run(n: usize, steps: usize, gravity: bool) -> (f64, Vec<DVec3>) {
     if gravity {
         app.add_external_force("gravity", Arc::new(Gravity));
     }
-    packing_pipeline()
-        .disable::<RecordPlugin>()
-        .build(&mut app);
+    packing_pipeline().disable::<RecordPlugin>().build(&mut app);
     app.finish().unwrap();
     for _ in 0..steps {
         app.step();
@@ -150,7 +148,10 @@ fn contribution_component_is_refused_naming_the_kernel_api() {
 
 #[test]
 fn kernels_are_refused_by_the_single_particle_schemes() {
-    for scheme in [OverlapRemovalScheme::Original, OverlapRemovalScheme::Revised] {
+    for scheme in [
+        OverlapRemovalScheme::Original,
+        OverlapRemovalScheme::Revised,
+    ] {
         let mut app = world(10, scheme);
         app.add_external_force("gravity", Arc::new(Gravity));
         packing_pipeline().build(&mut app);

@@ -157,7 +157,16 @@ def decode_extra(factory, schema, channel, data):
     """Decodes a message of a plugin channel from the embedded schema; returns JSON-able data."""
     decoder = factory.decoder_for(channel.message_encoding, schema)
     if decoder is not None:
-        return MessageToDict(decoder(data), preserving_proto_field_name=True)
+        try:  # protobuf >= 5.26 names the option so; older versions differently
+            return MessageToDict(
+                decoder(data),
+                preserving_proto_field_name=True,
+                always_print_fields_with_no_presence=True,
+            )
+        except TypeError:
+            return MessageToDict(
+                decoder(data), preserving_proto_field_name=True, including_default_value_fields=True
+            )
     if channel.message_encoding == "json":
         return json.loads(data)
     return {"bytes_base64": base64.b64encode(data).decode()}

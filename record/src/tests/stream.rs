@@ -218,3 +218,26 @@ fn record_reads_files_of_the_previous_version() {
     let (_, bytes) = write_recording("v0-rewrite.mcap", &rec.frames, false);
     assert_frames_bitwise_eq(&read_recording_bytes(&bytes).unwrap().frames, &rec.frames);
 }
+
+/// Every `/state` field is written, zero values included, so `-0.0` and empty frames survive.
+#[test]
+fn record_zero_and_negative_zero_fields_round_trip() {
+    let frame = ParticleFrame {
+        time: -0.0,
+        box_edges: glam::DVec3::new(-0.0, 0.0, -0.0),
+        status_json: String::new(),
+        ..Default::default()
+    };
+    let mut with_particle = frame.clone();
+    with_particle.ids = vec![0];
+    with_particle.positions = vec![glam::DVec3::splat(-0.0)];
+    with_particle.orientations = vec![glam::DQuat::from_xyzw(-0.0, 0.0, -0.0, 1.0)];
+    with_particle.radii = vec![-0.0];
+    with_particle.half_lengths = vec![0.0];
+    with_particle.rng_states = vec![[0; 4]];
+    let frames = [frame, with_particle];
+    let (_, bytes) = write_recording("zeros.mcap", &frames, false);
+    let rec = read_recording_bytes(&bytes).unwrap();
+    assert_frames_bitwise_eq(&rec.frames, &frames);
+    assert_eq!(rec.frames[0].time.to_bits(), (-0.0f64).to_bits());
+}

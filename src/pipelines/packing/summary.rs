@@ -1,9 +1,9 @@
 //! Machine-readable run summaries (JSON), shared by `run` and `replay`.
 
 use bevy_ecs::prelude::*;
+use magsep_components::packing::{OverlapRemovalScheme, VolumeStepRule};
 use magsep_components::prelude::*;
 use magsep_systems::packing::systems::PackingObservables;
-use magsep_components::packing::{OverlapRemovalScheme, VolumeStepRule};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 

@@ -44,7 +44,9 @@ pub fn replay_particle_fluid(
         .map(|(e, id)| (id.0, e))
         .collect();
     let dt = app.world.resource::<StepClock>().dt;
-    for frame in &rec.frames {
+    // the run observes after each step, never at step 0: the recorded start frame is skipped
+    let frames: Vec<_> = rec.frames.iter().filter(|f| f.step > 0).collect();
+    for frame in &frames {
         if frame.ids.len() != entities.len() {
             return Err(ReplayError::BadFrame {
                 step: frame.step,
@@ -71,7 +73,7 @@ pub fn replay_particle_fluid(
         app.observe_now();
     }
     let mut summary = super::run_summary(&app.world, seed, recorded_wall_time(rec));
-    summary["frames_replayed"] = Value::from(rec.frames.len());
+    summary["frames_replayed"] = Value::from(frames.len());
     if let Some(t) = &rec.truncated {
         summary["truncated"] = Value::String(t.clone());
     }

@@ -12,8 +12,8 @@ use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-use super::external::PackingKernels;
 use super::compress::{DriverParams, compress, next_volume_step, settle_step};
+use super::external::PackingKernels;
 use super::neighbour::NeighbourList;
 use super::removal::RemovalOutcome;
 use super::state::PackingState;
