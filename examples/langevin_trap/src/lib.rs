@@ -8,6 +8,7 @@
 //! * [`scene`]: the `[trap]` section and the `start` particle key, validated at key paths;
 //! * [`dynamics`]: spawning, the step and the statistics as ECS systems ([`LangevinTrapPlugin`]);
 //! * [`summary`]: the typed summary, from a run or recomputed from a recording;
+//! * [`channel`]: the recording channel `/langevin_trap/energy` ([`EnergyChannelPlugin`]);
 //! * [`LangevinTrapPipeline`]: the [`Pipeline`] hooks tying them together.
 //!
 //! ```no_run
@@ -19,6 +20,7 @@
 
 #![warn(missing_docs)]
 
+pub mod channel;
 pub mod dynamics;
 pub mod scene;
 pub mod summary;
@@ -34,6 +36,7 @@ use magsep::scene::{ParseContext, Pipeline, Registry, RunInfo, Scene, SceneSecti
 use magsep::serde_json::{self, Value};
 use magsep::systems::rng::rng_from_state_words;
 
+pub use channel::{ENERGY_TOPIC, EnergyChannelPlugin, EnergyMessage};
 pub use dynamics::{LangevinTrapPlugin, TrapConfig};
 pub use scene::{TrapParams, TrapScene, TrapSection};
 pub use summary::{TrapStats, TrapSummary};
@@ -80,6 +83,7 @@ impl Pipeline for LangevinTrapPipeline {
             .add(CorePlugin)
             .add(LangevinTrapPlugin)
             .add(RecordPlugin)
+            .add(EnergyChannelPlugin)
     }
 
     fn is_finished(&self, world: &World) -> bool {
@@ -111,7 +115,8 @@ impl Pipeline for LangevinTrapPipeline {
         summary::summary_of(world, run.seed, run.wall_time_s)
     }
 
-    fn prepare_recording(&self, world: &mut World, _writer: &mut RecordingWriter) {
+    fn prepare_recording(&self, world: &mut World, writer: &mut RecordingWriter) {
+        channel::open_energy_channel(world, writer);
         world
             .get_resource_or_init::<FrameStatusProviders>()
             .set(STATUS_KEY, |w| {
@@ -150,8 +155,12 @@ pub fn apply_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Repla
         .map_err(|e| bad(format!("status_json.{STATUS_KEY}: {e}")))?
         .ok_or_else(|| bad(format!("status_json has no `{STATUS_KEY}` statistics")))?;
     let mut q = world.query::<(&ParticleId, &mut Position, &mut ParticleRng)>();
-    let mut index: std::collections::HashMap<u64, usize> =
-        frame.ids.iter().enumerate().map(|(i, id)| (*id, i)).collect();
+    let mut index: std::collections::HashMap<u64, usize> = frame
+        .ids
+        .iter()
+        .enumerate()
+        .map(|(i, id)| (*id, i))
+        .collect();
     let mut count = 0;
     for (id, mut pos, mut rng) in q.iter_mut(world) {
         let Some(i) = index.remove(&id.0) else {

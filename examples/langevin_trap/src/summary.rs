@@ -196,8 +196,8 @@ pub fn replay(rec: &Recording, scene: &Scene, seed: u64) -> Result<serde_json::V
             stats.samples, last.step, p.sample_every
         )));
     }
-    let mut summary = TrapSummary::new(&p, &stats, n, last.step, seed, recorded_wall_time(rec))
-        .to_json();
+    let mut summary =
+        TrapSummary::new(&p, &stats, n, last.step, seed, recorded_wall_time(rec)).to_json();
     if let Some(t) = &rec.truncated {
         summary["truncated"] = serde_json::Value::String(t.clone());
     }

@@ -38,23 +38,47 @@ fn run_record_info_replay() {
     let scene = write(&dir, "trap.toml", &trap_scene(100, 2e-3, 100, 10, ""));
     let rec = dir.join("out.mcap").display().to_string();
     let out = bin(&["run", &scene, "--record", &rec, "--quiet"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary = json(&out);
     assert_eq!(summary["pipeline"], "langevin_trap");
     assert_eq!(summary["steps"], 100);
 
     let out = bin(&["info", &rec, "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let info = json(&out);
     let text = info.to_string();
     assert!(text.contains("/state"), "{info}");
     assert!(text.contains("langevin_trap"), "{info}");
+    let energy = info["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["topic"] == "/langevin_trap/energy")
+        .unwrap_or_else(|| panic!("no energy channel: {info}"));
+    assert_eq!(energy["schema"], "langevin_trap.Energy");
+    assert_eq!(energy["encoding"], "protobuf");
+    assert_eq!(energy["messages"], info["frames"]);
 
     let out = bin(&["replay", &rec]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let replayed = json(&out);
     let keys: Vec<&String> = summary.as_object().unwrap().keys().collect();
-    assert_eq!(replayed.as_object().unwrap().keys().collect::<Vec<_>>(), keys);
+    assert_eq!(
+        replayed.as_object().unwrap().keys().collect::<Vec<_>>(),
+        keys
+    );
     assert_eq!(replayed["variance_m2"], summary["variance_m2"]);
     assert_eq!(replayed["msd_m2"], summary["msd_m2"]);
 }
@@ -64,7 +88,11 @@ fn validate_reports_key_paths() {
     let dir = temp_dir("cli_validate");
     let good = write(&dir, "good.toml", &trap_scene(10, 1e-3, 100, 10, ""));
     let out = bin(&["validate", &good]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(json(&out)["pipeline"], "langevin_trap");
 
     let bad = trap_scene(10, 1e-3, 100, 10, "").replace("stiffness = 1e-6", "stiffness = -1");

@@ -45,7 +45,10 @@ fn equilibrium_variance_is_kt_over_k() {
     let se = (theory / (2000.0 * samples as f64)).sqrt();
     for a in 0..3 {
         let m = s["mean_displacement_m"][a].as_f64().unwrap();
-        assert!(m.abs() < 5.0 * se, "axis {a}: mean {m} m, standard error {se} m");
+        assert!(
+            m.abs() < 5.0 * se,
+            "axis {a}: mean {m} m, standard error {se} m"
+        );
     }
 }
 
@@ -64,15 +67,20 @@ fn mean_relaxes_exponentially() {
             continue;
         }
         let mut q = sim.app.world.query::<&Position>();
-        let mean: DVec3 =
-            q.iter(&sim.app.world).map(|p| p.0 - centre).sum::<DVec3>() / n as f64;
+        let mean: DVec3 = q.iter(&sim.app.world).map(|p| p.0 - centre).sum::<DVec3>() / n as f64;
         let t = step as f64 * 1e-3;
         let expected = offset * (-t / tau()).exp();
         // variance at t from a fixed start: kT/k (1 - e^{-2t/τ})
         let se = (theory_var * (1.0 - (-2.0 * t / tau()).exp()) / n as f64).sqrt();
-        eprintln!("t = {t} s: mean x {:.4e} m, expected {expected:.4e} m (se {se:.1e})", mean.x);
+        eprintln!(
+            "t = {t} s: mean x {:.4e} m, expected {expected:.4e} m (se {se:.1e})",
+            mean.x
+        );
         assert!((mean.x - expected).abs() < 5.0 * se, "t = {t}");
-        assert!(mean.y.abs() < 5.0 * se && mean.z.abs() < 5.0 * se, "t = {t}");
+        assert!(
+            mean.y.abs() < 5.0 * se && mean.z.abs() < 5.0 * se,
+            "t = {t}"
+        );
     }
 }
 

@@ -77,7 +77,10 @@ fn bad_values_at_their_key_paths() {
         );
     }
     let e = errors(&with_trap("centre", "[0.0, inf, 0.0]"));
-    assert!(has(&e, "trap.centre[1]", "must be a finite number"), "{e:?}");
+    assert!(
+        has(&e, "trap.centre[1]", "must be a finite number"),
+        "{e:?}"
+    );
     let e = errors(&with_trap("centre", "[0.0, 1.0]"));
     assert!(e.iter().any(|e| e.starts_with("trap.centre")), "{e:?}");
     let e = errors(&with_trap("stiffness", "\"stiff\""));
@@ -96,29 +99,43 @@ fn unknown_and_missing_keys() {
     assert!(has(&e, "trap.spring", "unknown key"), "{e:?}");
     let e = errors(&trap_scene(10, 1e-3, 100, 10, "").replace("stiffness = 1e-6\n", ""));
     assert!(has(&e, "trap.stiffness", "missing required key"), "{e:?}");
-    let no_trap = trap_scene(10, 1e-3, 100, 10, "")
-        .replace("[trap]", "[other]");
+    let no_trap = trap_scene(10, 1e-3, 100, 10, "").replace("[trap]", "[other]");
     let e = errors(&no_trap);
     assert!(has(&e, "trap", "missing required table [trap]"), "{e:?}");
     let e = errors(&format!(
         "{}\n[record]\nevery = 5\n",
         trap_scene(10, 1e-3, 100, 10, "")
     ));
-    assert!(has(&e, "trap.record_every", "conflicts with record.every = 5"), "{e:?}");
+    assert!(
+        has(&e, "trap.record_every", "conflicts with record.every = 5"),
+        "{e:?}"
+    );
 }
 
 #[test]
 fn start_is_checked_at_its_path() {
     let scene = |start: &str| {
-        trap_scene(10, 1e-3, 100, 10, "")
-            .replace("start = [1.2e-6, -2e-6, 0.5e-6]", &format!("start = {start}"))
+        trap_scene(10, 1e-3, 100, 10, "").replace(
+            "start = [1.2e-6, -2e-6, 0.5e-6]",
+            &format!("start = {start}"),
+        )
     };
     let e = errors(&scene("[0.0, nan, 0.0]"));
-    assert!(has(&e, "particles[0].start[1]", "must be a finite number, got NaN"), "{e:?}");
+    assert!(
+        has(
+            &e,
+            "particles[0].start[1]",
+            "must be a finite number, got NaN"
+        ),
+        "{e:?}"
+    );
     let e = errors(&scene("\"origin\""));
     assert!(has(&e, "particles[0].start", "invalid type"), "{e:?}");
     let e = errors(&scene("[1.0, 2.0]"));
-    assert!(e.iter().any(|e| e.starts_with("particles[0].start")), "{e:?}");
+    assert!(
+        e.iter().any(|e| e.starts_with("particles[0].start")),
+        "{e:?}"
+    );
     // integers are numbers too
     parse(&scene("[0, 0, 0]"));
     // without start the particles start at the centre
@@ -144,14 +161,18 @@ fn trap_keys_belong_to_this_pipeline() {
     // the registry knows both pipelines: [trap] in a packing scene names its owner
     assert!(parse_scene(PACKING, &registry()).is_ok());
     let e = errors(&format!("{PACKING}\n[trap]\nstiffness = 1e-6\n"));
-    assert!(has(&e, "trap", "only for pipeline = \"langevin_trap\""), "{e:?}");
-    let with_start = PACKING.replace(
-        "radius = 0.5 }",
-        "radius = 0.5 }\nstart = [0.0, 0.0, 0.0]",
+    assert!(
+        has(&e, "trap", "only for pipeline = \"langevin_trap\""),
+        "{e:?}"
     );
+    let with_start = PACKING.replace("radius = 0.5 }", "radius = 0.5 }\nstart = [0.0, 0.0, 0.0]");
     let e = errors(&with_start);
     assert!(
-        has(&e, "particles[0].start", "only for pipeline = \"langevin_trap\""),
+        has(
+            &e,
+            "particles[0].start",
+            "only for pipeline = \"langevin_trap\""
+        ),
         "{e:?}"
     );
     // a key of another pipeline is refused here
@@ -159,5 +180,8 @@ fn trap_keys_belong_to_this_pipeline() {
         "{}\n[container]\nkind = \"periodic_box\"\n",
         trap_scene(10, 1e-3, 100, 10, "")
     ));
-    assert!(has(&e, "container", "only for pipeline = \"packing\""), "{e:?}");
+    assert!(
+        has(&e, "container", "only for pipeline = \"packing\""),
+        "{e:?}"
+    );
 }
