@@ -36,13 +36,13 @@ pub struct EnergyMessage {
     /// Schedule step of the frame.
     #[prost(uint64, tag = "1")]
     pub step: u64,
-    /// Simulated time `step * Δt` [s].
+    /// Simulated time `step * Δt` \[s\].
     #[prost(double, tag = "2")]
     pub time_s: f64,
-    /// Mean potential energy per particle ⟨k |x - x0|² / 2⟩ [J] (equilibrium: 3 k_B T / 2).
+    /// Mean potential energy per particle ⟨k |x - x0|² / 2⟩ \[J\] (equilibrium: 3 k_B T / 2).
     #[prost(double, tag = "3")]
     pub mean_potential_energy_j: f64,
-    /// Mean square displacement from the centre ⟨|x - x0|²⟩ [m²] (equilibrium: 3 k_B T / k).
+    /// Mean square displacement from the centre ⟨|x - x0|²⟩ \[m²\] (equilibrium: 3 k_B T / k).
     #[prost(double, tag = "4")]
     pub msd_m2: f64,
 }
@@ -80,7 +80,7 @@ pub fn energy_schema() -> Result<ProtobufSchema, RecordError> {
 #[derive(Resource, Debug, Clone)]
 pub struct EnergyChannel(pub Result<ChannelHandle, String>);
 
-/// MCAP log time [ns] of a frame at `step` and `time` [s]: the rule of the `/state` frames
+/// MCAP log time \[ns\] of a frame at `step` and `time` \[s\]: the rule of the `/state` frames
 /// (`magsep::plugins::record::log_time_ns`), so a message and its frame share a log time.
 pub fn log_time(step: u64, time: f64) -> u64 {
     if time == 0.0 {

@@ -32,17 +32,17 @@ use crate::summary::TrapStats;
 pub struct TrapConfig(pub TrapParams);
 
 /// Per-particle coefficients of the exact step (a component): `decay` = e^{-k Δt/γ} and
-/// `noise` = sqrt(k_B T / k (1 - decay²)) [m].
+/// `noise` = sqrt(k_B T / k (1 - decay²)) \[m\].
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 pub struct OuStep {
     /// Factor on the displacement from the centre over one step.
     pub decay: f64,
-    /// Standard deviation of the random displacement per axis over one step [m].
+    /// Standard deviation of the random displacement per axis over one step \[m\].
     pub noise: f64,
 }
 
 impl OuStep {
-    /// The coefficients for a sphere of friction `gamma` [kg/s] under `p`.
+    /// The coefficients for a sphere of friction `gamma` \[kg/s\] under `p`.
     pub fn new(p: &TrapParams, gamma: f64) -> Self {
         let decay = (-p.stiffness * p.dt / gamma).exp();
         // 1 - e^{-2x} without cancellation for small x
@@ -112,7 +112,7 @@ pub fn ou_step(config: Res<TrapConfig>, mut q: Query<(&mut Position, &mut Partic
     });
 }
 
-/// The particles' displacements from the centre `x - x0` [m], in `ParticleId` order (the
+/// The particles' displacements from the centre `x - x0` \[m\], in `ParticleId` order (the
 /// summation order of every statistic, here and in replay).
 pub fn displacements(rows: &[(ParticleId, DVec3)], centre: DVec3) -> Vec<DVec3> {
     let mut rows = rows.to_vec();

@@ -44,24 +44,24 @@ pub const MAX_STEPS: f64 = 1e12;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrapSection {
-    /// Trap stiffness k [N/m]. Range: finite, > 0.
+    /// Trap stiffness k \[N/m\]. Range: finite, > 0.
     pub stiffness: f64,
-    /// Trap centre x0 [m]. Default: the origin.
+    /// Trap centre x0 \[m\]. Default: the origin.
     #[serde(default)]
     pub centre: [f64; 3],
-    /// Temperature T [K]. Range: finite, > 0.
+    /// Temperature T \[K\]. Range: finite, > 0.
     pub temperature: f64,
-    /// Dynamic viscosity η of the fluid [Pa s]. Range: finite, > 0.
+    /// Dynamic viscosity η of the fluid \[Pa s\]. Range: finite, > 0.
     pub viscosity: f64,
-    /// Time step Δt [s]. Range: finite, > 0. The update is exact for any Δt.
+    /// Time step Δt \[s\]. Range: finite, > 0. The update is exact for any Δt.
     pub time_step: f64,
-    /// Simulated time [s]; the run has `round(duration / time_step)` steps (>= 1).
+    /// Simulated time \[s\]; the run has `round(duration / time_step)` steps (>= 1).
     pub duration: f64,
     /// Steps between samples of the statistics and recorded frames. Default: `[record]
     /// every` if given, else one correlation time `γ/k` of the slowest particle in steps.
     #[serde(default)]
     pub record_every: Option<u64>,
-    /// Time discarded before sampling [s] (particles relax from `start`). Default: five
+    /// Time discarded before sampling \[s\] (particles relax from `start`). Default: five
     /// correlation times `5 γ/k` of the slowest particle. Range: finite, >= 0, < duration.
     #[serde(default)]
     pub equilibration: Option<f64>,
@@ -73,12 +73,12 @@ pub struct TrapSection {
 pub struct TrapScene {
     /// `[trap]`.
     pub trap: TrapSection,
-    /// `start` [m] of each particle group (the centre where absent).
+    /// `start` \[m\] of each particle group (the centre where absent).
     pub starts: Vec<DVec3>,
 }
 
-/// Friction coefficient γ = 6 π η a of a sphere of radius `radius` [m] in a fluid of
-/// viscosity `viscosity` [Pa s], in [kg/s] (Stokes drag).
+/// Friction coefficient γ = 6 π η a of a sphere of radius `radius` \[m\] in a fluid of
+/// viscosity `viscosity` \[Pa s\], in \[kg/s\] (Stokes drag).
 pub fn friction(viscosity: f64, radius: f64) -> f64 {
     6.0 * std::f64::consts::PI * viscosity * radius
 }
@@ -87,13 +87,13 @@ pub fn friction(viscosity: f64, radius: f64) -> f64 {
 /// [`crate::dynamics`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrapParams {
-    /// k [N/m].
+    /// k \[N/m\].
     pub stiffness: f64,
-    /// x0 [m].
+    /// x0 \[m\].
     pub centre: DVec3,
-    /// k_B T [J].
+    /// k_B T \[J\].
     pub kt: f64,
-    /// Δt [s].
+    /// Δt \[s\].
     pub dt: f64,
     /// Steps of the run.
     pub steps: u64,
@@ -104,7 +104,7 @@ pub struct TrapParams {
 }
 
 impl TrapParams {
-    /// The parameters of `trap` for particles of largest radius `max_radius` [m], with the
+    /// The parameters of `trap` for particles of largest radius `max_radius` \[m\], with the
     /// scene's `[record] every` if given.
     pub fn new(trap: &TrapSection, max_radius: f64, record_every: Option<u64>) -> Self {
         let tau = friction(trap.viscosity, max_radius) / trap.stiffness;
@@ -144,7 +144,7 @@ impl TrapParams {
         ))
     }
 
-    /// The equilibrium variance per axis k_B T / k [m²].
+    /// The equilibrium variance per axis k_B T / k \[m²\].
     pub fn variance(&self) -> f64 {
         self.kt / self.stiffness
     }

@@ -24,9 +24,9 @@ pub struct TrapStats {
     pub samples: u64,
     /// Number of (particle, step) values per axis.
     pub values: u64,
-    /// Σ (x - x0) per axis [m].
+    /// Σ (x - x0) per axis \[m\].
     pub sum: [f64; 3],
-    /// Σ (x - x0)² per axis [m²].
+    /// Σ (x - x0)² per axis \[m²\].
     pub sum_sq: [f64; 3],
 }
 
@@ -43,20 +43,20 @@ impl TrapStats {
         }
     }
 
-    /// Mean displacement per axis [m] (NaN without samples).
+    /// Mean displacement per axis \[m\] (NaN without samples).
     pub fn mean(&self) -> [f64; 3] {
         let n = self.values as f64;
         self.sum.map(|s| s / n)
     }
 
-    /// Variance per axis about the sample mean [m²] (NaN without samples).
+    /// Variance per axis about the sample mean \[m²\] (NaN without samples).
     pub fn variance(&self) -> [f64; 3] {
         let n = self.values as f64;
         let m = self.mean();
         std::array::from_fn(|a| self.sum_sq[a] / n - m[a] * m[a])
     }
 
-    /// Mean square displacement from the centre ⟨|x - x0|²⟩ [m²] (theory 3 k_B T / k).
+    /// Mean square displacement from the centre ⟨|x - x0|²⟩ \[m²\] (theory 3 k_B T / k).
     pub fn msd(&self) -> f64 {
         self.sum_sq.iter().sum::<f64>() / self.values as f64
     }
@@ -72,19 +72,19 @@ pub struct TrapSummary {
     pub particles: u64,
     /// Steps done.
     pub steps: u64,
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub time_s: f64,
     /// Steps sampled (after the equilibration, every `sample_every` steps).
     pub samples: u64,
     /// Steps between samples.
     pub sample_every: u64,
-    /// Mean displacement from the centre per axis [m] (theory 0).
+    /// Mean displacement from the centre per axis \[m\] (theory 0).
     pub mean_displacement_m: [f64; 3],
-    /// Variance of the position per axis [m²] (theory k_B T / k).
+    /// Variance of the position per axis \[m²\] (theory k_B T / k).
     pub variance_m2: [f64; 3],
-    /// Mean square displacement from the centre ⟨|x - x0|²⟩ [m²] (theory 3 k_B T / k).
+    /// Mean square displacement from the centre ⟨|x - x0|²⟩ \[m²\] (theory 3 k_B T / k).
     pub msd_m2: f64,
-    /// The equilibrium variance per axis k_B T / k [m²].
+    /// The equilibrium variance per axis k_B T / k \[m²\].
     pub theory_variance_m2: f64,
     /// (variance - k_B T / k) / (k_B T / k) per axis.
     pub relative_error: [f64; 3],
@@ -92,7 +92,7 @@ pub struct TrapSummary {
     pub max_relative_error: f64,
     /// Seed of the run.
     pub seed: u64,
-    /// Wall time of the run [s].
+    /// Wall time of the run \[s\].
     pub wall_time_s: f64,
 }
 
