@@ -25,7 +25,8 @@
 use magsep::components::brownian::BOLTZMANN;
 use magsep::glam::DVec3;
 use magsep::scene::checks::{check, finite_positive, typed};
-use magsep::scene::{ParseContext, Scene, ShapeSpec};
+use magsep::scene::{ParseContext, Scene, SceneError, ShapeSpec};
+use magsep::toml;
 use serde::{Deserialize, Serialize};
 
 /// The pipeline's name in `[simulation] pipeline = "..."`.
@@ -155,18 +156,67 @@ impl TrapParams {
     }
 }
 
-/// Errors at `path` unless every component of `v` is finite (`path[i]`).
-fn finite_point(cx: &mut ParseContext<'_>, path: &str, v: [f64; 3]) {
-    for (i, x) in v.iter().enumerate() {
-        check(cx.errors, x.is_finite(), &format!("{path}[{i}]"), || {
+/// A point \[m\] at `path`: an array of three finite numbers (integers allowed). Every
+/// problem is pushed at its innermost path (`path[i]` for a bad component).
+fn point(errors: &mut Vec<SceneError>, value: &toml::Value, path: &str) -> Option<[f64; 3]> {
+    let Some(items) = value.as_array() else {
+        errors.push(SceneError::new(
+            path,
+            format!(
+                "must be an array of 3 numbers [m], got a {}",
+                value.type_str()
+            ),
+        ));
+        return None;
+    };
+    if items.len() != 3 {
+        errors.push(SceneError::new(
+            path,
+            format!(
+                "must be an array of 3 numbers [m], got {} items",
+                items.len()
+            ),
+        ));
+        return None;
+    }
+    let before = errors.len();
+    let mut p = [0.0; 3];
+    for (i, item) in items.iter().enumerate() {
+        let x = match item {
+            toml::Value::Float(x) => *x,
+            toml::Value::Integer(n) => *n as f64,
+            other => {
+                errors.push(SceneError::new(
+                    format!("{path}[{i}]"),
+                    format!("must be a number, got a {}", other.type_str()),
+                ));
+                continue;
+            }
+        };
+        check(errors, x.is_finite(), &format!("{path}[{i}]"), || {
             format!("must be a finite number, got {x}")
         });
+        p[i] = x;
     }
+    (errors.len() == before).then_some(p)
+}
+
+/// `[trap]` typed; `centre` is checked by [`point`] (for key paths like `trap.centre[1]`).
+fn trap_section(cx: &mut ParseContext<'_>) -> Option<TrapSection> {
+    let mut table = cx.required::<toml::Table>(SECTION, PIPELINE)?;
+    let centre = match table.remove("centre") {
+        None => Some([0.0; 3]),
+        Some(v) => point(cx.errors, &v, &format!("{SECTION}.centre")),
+    };
+    let section = typed::<TrapSection>(&toml::Value::Table(table), SECTION, cx.errors);
+    let (mut section, centre) = (section?, centre?);
+    section.centre = centre;
+    Some(section)
 }
 
 /// Type and check `[trap]` and each group's `start`, pushing every problem at its key path.
 pub fn parse(cx: &mut ParseContext<'_>) -> Option<TrapScene> {
-    let trap = cx.required::<TrapSection>(SECTION, PIPELINE);
+    let trap = trap_section(cx);
     let mut ok = trap.is_some();
     if let Some(t) = &trap {
         let before = cx.errors.len();
@@ -179,7 +229,6 @@ pub fn parse(cx: &mut ParseContext<'_>) -> Option<TrapScene> {
         ] {
             finite_positive(cx.errors, &format!("{SECTION}.{key}"), v);
         }
-        finite_point(cx, &format!("{SECTION}.centre"), t.centre);
         if cx.errors.len() == before {
             let steps = t.duration / t.time_step;
             check(
@@ -230,7 +279,7 @@ pub fn parse(cx: &mut ParseContext<'_>) -> Option<TrapScene> {
     }
     let centre = trap.as_ref().map(|t| t.centre).unwrap_or_default();
     let mut starts = Vec::with_capacity(cx.particles.len());
-    let groups: Vec<(usize, ShapeSpec, Option<magsep::toml::Value>)> = cx
+    let groups: Vec<(usize, ShapeSpec, Option<toml::Value>)> = cx
         .particles
         .iter()
         .map(|(i, g)| (*i, g.shape, g.extra.get(START_KEY).cloned()))
@@ -246,15 +295,7 @@ pub fn parse(cx: &mut ParseContext<'_>) -> Option<TrapScene> {
         }
         let start = match start {
             None => Some(centre),
-            Some(v) => {
-                let key = format!("{path}.{START_KEY}");
-                let before = cx.errors.len();
-                let p = typed::<[f64; 3]>(&v, &key, cx.errors);
-                if let Some(p) = p {
-                    finite_point(cx, &key, p);
-                }
-                p.filter(|_| cx.errors.len() == before)
-            }
+            Some(v) => point(cx.errors, &v, &format!("{path}.{START_KEY}")),
         };
         match start {
             Some(p) => starts.push(DVec3::from_array(p)),
