@@ -117,8 +117,9 @@ impl TrapParams {
             .unwrap_or_else(|| ((tau / dt).round() as u64).max(1));
         let eq = trap.equilibration.unwrap_or(5.0 * tau);
         // the first multiple of `sample_every` at or after the equilibration time (never 0)
-        let eq_steps = ((eq / dt).ceil() as u64).max(1);
-        let first_sample = eq_steps.div_ceil(sample_every) * sample_every;
+        // (`as` saturates; past the last step nothing is sampled anyway)
+        let eq_steps = ((eq / dt).ceil() as u64).clamp(1, steps.saturating_add(1));
+        let first_sample = eq_steps.div_ceil(sample_every).saturating_mul(sample_every);
         Self {
             stiffness: trap.stiffness,
             centre: DVec3::from_array(trap.centre),
@@ -300,6 +301,26 @@ pub fn parse(cx: &mut ParseContext<'_>) -> Option<TrapScene> {
         match start {
             Some(p) => starts.push(DVec3::from_array(p)),
             None => ok = false,
+        }
+    }
+    if let Some(t) = trap.as_ref().filter(|t| ok && t.equilibration.is_none()) {
+        // the default equilibration must leave time to sample
+        let max_radius = cx
+            .particles
+            .iter()
+            .map(|(_, g)| g.shape.shape().radius())
+            .fold(0.0, f64::max);
+        let eq = 5.0 * friction(t.viscosity, max_radius) / t.stiffness;
+        if eq.is_finite() && eq >= t.duration {
+            cx.error(
+                format!("{SECTION}.duration"),
+                format!(
+                    "must exceed the default equilibration 5 γ/k = {eq:e} s of the largest \
+                     sphere (set trap.equilibration to sample earlier), got {}",
+                    t.duration
+                ),
+            );
+            ok = false;
         }
     }
     match trap {

@@ -97,6 +97,13 @@ fn bad_values_at_their_key_paths() {
     assert!(has(&e, "trap.record_every", "must be >= 1"), "{e:?}");
     let e = errors(&with_trap("duration", "1e-5"));
     assert!(has(&e, "trap.duration", "between 1 and"), "{e:?}");
+    // 5 γ/k = 47 ms of default equilibration leaves no time to sample in 20 ms
+    let e = errors(&trap_scene(10, 1e-3, 20, 10, ""));
+    assert!(
+        has(&e, "trap.duration", "must exceed the default equilibration"),
+        "{e:?}"
+    );
+    parse(&trap_scene(10, 1e-3, 20, 10, "equilibration = 0.0"));
     let e = errors(&trap_scene(10, 1e-3, 100, 10, "equilibration = 0.5"));
     assert!(has(&e, "trap.equilibration", "< duration"), "{e:?}");
 }
