@@ -1,4 +1,4 @@
-//! Qualitative capture physics of thesis 000, ch. 6 (spec §5 item 8) as fast checks of the
+//! Qualitative capture physics of thesis 000, ch. 6 (target V-FB-8) as fast checks of the
 //! brownian pipeline: one magnetised cylinder (D = 600 µm, L/D = 20, M_s = 985 kA/m with its
 //! Stoner-Wohlfarth direction) in a 1 T field at angle α to its axis (axis along z, field
 //! `[sin α, 0, cos α]`), table 6.1 particles. Particle numbers, durations and time steps are
@@ -143,7 +143,7 @@ fn arc(n: usize, rho: f64, z: f64, phi0: f64, spread: f64) -> Vec<DVec3> {
 }
 
 /// Longitudinal magnetisation (α = 0): the end face attracts, the mid-length lateral surface
-/// is inactive (~1e-17 N, spec §2.9), so in 0.2 s particles 10 µm above the face are captured
+/// is inactive (~1e-17 N, D-000-11), so in 0.2 s particles 10 µm above the face are captured
 /// and particles 10 µm beside the mid-length surface are not (free diffusion covers only
 /// √(6D·0.2 s) ≈ 1.4 µm for R = 125 nm).
 #[test]
@@ -186,7 +186,7 @@ fn longitudinal_captures_only_at_the_end_face() {
 }
 
 /// Transverse magnetisation (α = 90°, field along +x): the poles φ = 0, π attract and the
-/// equator φ = ±90° repels (spec §2.9: |F| ≈ 1.9e-12 N outward at 10 µm). In 0.03 s particles
+/// equator φ = ±90° repels (D-000-11: |F| ≈ 1.9e-12 N outward at 10 µm). In 0.03 s particles
 /// 10 µm off the poles are captured (drift ~800 µm/s for R = 125 nm) while those off the
 /// equator are pushed away, not captured.
 #[test]
@@ -271,13 +271,13 @@ fn travel_time(alpha_deg: f64, a: f64, mu: f64, start: DVec3) -> f64 {
     t
 }
 
-/// Spec §2.9: a lone R = 75 nm particle from 100 µm above the rim (L/D = 20) reaches the
+/// D-000-11 (docs/references.md): a lone R = 75 nm particle from 100 µm above the rim (L/D = 20) reaches the
 /// cylinder after 0.60 s at α = 0 and 0.96 s at α = 90° without noise. With a saturated moment
 /// the drift is |m| ∇|B| / (6πηR), so the time scales as R/|m|; for R = 212 nm
 /// (μ = 19.35e-16 A m²) the targets are 0.60 · 0.1272 = 0.076 s and 0.122 s. At R = 212 nm the
 /// Brownian spread over the path is √(2D·0.1 s) ≈ 0.45 µm per axis, 0.5 % of the 100 µm path,
 /// so the pipeline's median capture time must match the drift-only time. Tolerances: 10 % on
-/// the spec's numbers (they are two-significant-figure [derived] values and "above the rim"
+/// the D-000-11 numbers (they are two-significant-figure derived values and "above the rim"
 /// is not specified to better than a few µm), 5 % between the pipeline and this test's own RK4
 /// integration of the same field (noise, 2 ms sampling of the capture curve).
 #[test]
@@ -285,11 +285,11 @@ fn deterministic_travel_time_matches_the_spec() {
     let scale = (212e-9 / MU_212) / (75e-9 / MU_75);
     let start = DVec3::new(RADIUS, 0.0, HALF_LENGTH + 100e-6);
     for (alpha, spec_75) in [(0.0, 0.60), (90.0, 0.96)] {
-        // drift-only, 75 nm: directly against the spec
+        // drift-only, 75 nm: directly against D-000-11
         let t75 = travel_time(alpha, 75e-9, MU_75, start);
         assert!(
             (t75 / spec_75 - 1.0).abs() < 0.10,
-            "α = {alpha}: drift-only travel time {t75} s vs spec {spec_75} s"
+            "α = {alpha}: drift-only travel time {t75} s vs D-000-11 {spec_75} s"
         );
         // the pipeline with noise, 212 nm: 8 single-particle runs, median capture time
         let target = spec_75 * scale;
@@ -311,7 +311,7 @@ fn deterministic_travel_time_matches_the_spec() {
             .map(|(t, _)| t.as_f64().unwrap())
             .unwrap_or(f64::INFINITY);
         eprintln!(
-            "α = {alpha}: drift-only 75 nm {t75:.4} s (spec {spec_75}); 212 nm drift-only {t_rk4:.4} s, pipeline median {median:.4} s, scaled spec {target:.4} s"
+            "α = {alpha}: drift-only 75 nm {t75:.4} s (D-000-11 {spec_75}); 212 nm drift-only {t_rk4:.4} s, pipeline median {median:.4} s, scaled D-000-11 {target:.4} s"
         );
         assert!(
             (median / t_rk4 - 1.0).abs() < 0.05,
@@ -319,7 +319,7 @@ fn deterministic_travel_time_matches_the_spec() {
         );
         assert!(
             (median / target - 1.0).abs() < 0.10,
-            "α = {alpha}: pipeline median capture {median} s vs scaled spec {target} s"
+            "α = {alpha}: pipeline median capture {median} s vs scaled D-000-11 {target} s"
         );
     }
 }

@@ -99,7 +99,7 @@ fn separation_range(text: &str) -> (f64, f64) {
 
 #[test]
 fn dipole_pair_fixed_step_fails_at_thesis_dt_adaptive_does_not() {
-    // spec 2.9: at dt = 5e-5 s the dipole contact force moves a 75 nm particle by several
+    // D-000-10: at dt = 5e-5 s the dipole contact force moves a 75 nm particle by several
     // radii per step and D dt U''/kT at the Mie contact is 356 (explicit Euler needs < 2).
     let fixed = r#"{ kind = "fixed" }"#;
     let (lo, hi) = separation_range(&pair_scene(5e-5, 100, fixed));

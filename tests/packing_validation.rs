@@ -1,4 +1,4 @@
-//! Packing physics against the thesis's targets (spec packing.md section 14).
+//! Packing physics against the thesis's targets (targets V-PK-1 to V-PK-19 in docs/references.md).
 //!
 //! Default tier: fast versions (small N). `#[ignore]` tier, run in release by CI with
 //! `cargo test --release -- --ignored`: the thesis's sizes.
@@ -121,7 +121,7 @@ fn packing_fraction_is_non_monotonic_in_aspect_ratio_with_a_maximum_at_small_elo
 
 #[test]
 fn a_bad_xi_gives_little_compaction_in_the_original_scheme() {
-    // thesis L394: an improper xi gives "hardly any compaction"
+    // [T000 §2.3]: an improper xi gives "hardly any compaction"
     let original = |c: &mut PackingConfig| {
         c.scheme = OverlapRemovalScheme::Original;
         c.max_attempts = PackingConfig::default_max_attempts(OverlapRemovalScheme::Original, 50);

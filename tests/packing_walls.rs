@@ -257,7 +257,7 @@ placement = {{ kind = "box", min = [20.0, 20.0, 20.0], max = [21.0, 21.0, 21.0] 
     assert!(e.to_string().contains("fibre_packings[0].recording"), "{e}");
 }
 
-/// Release tier: the thesis's cylinder-confinement trends (spec packing.md 10.2) at reduced
+/// Release tier: the thesis's cylinder-confinement trends (target V-PK-16) at reduced
 /// size (N = 80, or more so that the column ends >= 3 particle lengths long; one seed; `magsep chart cylinder` runs the full sweep).
 #[test]
 #[ignore = "validation tier: run with --release -- --ignored"]

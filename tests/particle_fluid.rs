@@ -64,7 +64,7 @@ fn the_pipeline_follows_the_single_sphere_kernel() {
 
 #[test]
 fn levitation_time_with_and_without_history_through_the_pipeline() {
-    // spec 4 [CHECK]: rising 5 mm PVC-U from -0.9 L: 4.15 s with history, 2.15 s without
+    // D-002-5: rising 5 mm PVC-U from -0.9 L: 4.15 s with history, 2.15 s without
     let (_, with) = run(&levitation_scene(6.0, ""), RunOptions::default());
     let (_, without) = run(
         &levitation_scene(6.0, "terms = { history = false }"),

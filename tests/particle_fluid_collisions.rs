@@ -166,7 +166,7 @@ fn many_particle_runs_are_bitwise_identical_on_one_and_two_threads() {
 #[test]
 #[ignore = "validation tier (release): ~1000 particles, 2.5 s, three cases"]
 fn history_and_collisions_order_the_separation_error_curves() {
-    // thesis fig. 2.16a (spec 7.7): without history e_m falls fastest, without collisions
+    // thesis fig. 2.16a (target V-DS-7): without history e_m falls fastest, without collisions
     // next, with both slowest (here one-way coupled, periods / 3: 981 particles)
     let final_error = |name: &str| {
         let (_, s) = run(&mds(name, 3.0, 2.5), RunOptions::default());

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 pub const BOLTZMANN: f64 = 1.380_649e-23;
 
 /// How a particle's magnetic moment follows the local flux density B. The moment is always
-/// parallel to B (superparamagnetic particles, thesis L1673).
+/// parallel to B (superparamagnetic particles, [T000 §6.2.4]).
 ///
 /// ```
 /// use magsep_components::brownian::MomentModel;
@@ -281,7 +281,7 @@ mod tests {
             let m = -(free(b + h) - free(b - h)) / (2.0 * h);
             assert!((law.magnitude(b, kt) / m - 1.0).abs() < 1e-6, "B = {b}");
         }
-        // spec 2.4: a 10 nm magnetite core at 1 T: x ≈ 56, L ≈ 0.98; at 0.4 T L ≈ 0.96
+        // D-000-8 (docs/references.md): a 10 nm magnetite core at 1 T: x ≈ 56, L ≈ 0.98; at 0.4 T L ≈ 0.96
         assert!((law.magnitude(1.0, kt) / ms - 0.982).abs() < 0.002);
         assert!((law.magnitude(0.4, kt) / ms - 0.955).abs() < 0.005);
         assert_eq!(MomentModel::Saturated { moment: ms }.magnitude(0.1, kt), ms);

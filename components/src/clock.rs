@@ -1,4 +1,4 @@
-//! The integer step clock (house plan, section 3): time is `step * dt`, never accumulated.
+//! The integer step clock (docs/architecture.md §3, determinism): time is `step * dt`, never accumulated.
 
 use bevy_ecs::prelude::Resource;
 use serde::{Deserialize, Serialize};

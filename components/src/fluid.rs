@@ -1,6 +1,6 @@
 //! Inertial particles in a (magnetised) liquid: velocities, mass properties, the fluid sampled
 //! at each particle, and one force contribution per term of the extended Maxey-Riley
-//! equation (thesis 002, eq. 2.26 corrected; spec `density-separation-spheres.md` §2).
+//! equation (thesis 002, eq. 2.26 corrected; [T002 §2.2.4.1]; errata in docs/references.md).
 //! SI units throughout. Gravity acts along −z: magsep's vertical is z (Foxglove's up), the
 //! thesis's y.
 //!
@@ -143,7 +143,7 @@ pub struct Levitation {
     /// Equilibrium height z_e [m] (world) where the apparent density equals ρ_p (NaN if none).
     pub equilibrium_height: f64,
     /// Last time [s] the particle was farther than the tolerance from y_e (its levitation
-    /// time t_l once it has settled; thesis L791).
+    /// time t_l once it has settled; [T002 §2.5.1.1]).
     pub last_outside: f64,
 }
 

@@ -1,4 +1,4 @@
-//! Per-contribution forces (house plan, section 2).
+//! Per-contribution forces (docs/architecture.md §2, schedule).
 //!
 //! Every force model writes its **own** component (`FieldForce`, `DipoleForce`, a user's
 //! `MyForce`, ...), each implementing [`ForceContribution`]. The `Accumulate` set then sums the

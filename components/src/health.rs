@@ -1,4 +1,4 @@
-//! Numerical health of a run (house plan, section 6).
+//! Numerical health of a run (docs/architecture.md §6, errors).
 
 use bevy_ecs::prelude::Resource;
 use serde::{Deserialize, Serialize};

@@ -1,7 +1,7 @@
 //! # magsep-components
 //!
 //! Data only: ECS components, resources and validated newtypes shared by every magsep crate.
-//! No systems and no I/O live here (house plan, section 1). All quantities are SI unless a
+//! No systems and no I/O live here (docs/architecture.md §1, layout). All quantities are SI unless a
 //! field's documentation says otherwise.
 //!
 //! ```

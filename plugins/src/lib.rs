@@ -4,7 +4,8 @@
 //! as plugin groups, and MCAP record/replay.
 //!
 //! * [`app`]: [`app::SimApp`] and the [`app::SimPlugin`] trait.
-//! * [`group`]: [`group::PipelineGroup`]: add, disable, replace plugins.
+//! * [`group`]: [`group::PipelineGroup`]: add, disable, replace, configure plugins (by type,
+//!   label or index).
 //! * [`core`]: clock and health.
 //! * [`packing`]: the `packing` pipeline.
 //! * [`brownian`]: the `brownian` pipeline.

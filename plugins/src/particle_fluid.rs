@@ -16,7 +16,10 @@
 //! Model no more than a scene needs: the forces plugin registers only the contributions the
 //! scene's `ParticleFluidConfig` switches on and that can act (no magnetic buoyancy without a
 //! magnet, no flow sampling or undisturbed-flow force in a quiescent liquid, no collision
-//! plugin when collisions are off). Resources that must exist: `ParticleFluidConfig`,
+//! plugin when collisions are off). User forces: the integrator consumes `NetForce`, so every
+//! registered contribution (`SimApp::register_force`) and external force kernel
+//! (`SimApp::add_external_force`, summed into the built-in `KernelForce`) acts as an explicit
+//! force of the step start. Resources that must exist: `ParticleFluidConfig`,
 //! `FluidDomain`, `StepClock`; the particles carry `Velocity`, `AngularVelocity`,
 //! `InertialBody`, `FluidSample`, `Levitation`.
 

@@ -1,16 +1,15 @@
-//! Data preparation (transformed coordinates, skipped points) and the
-//! pixel mapping of a plot area.
+//! Data preparation: transformed coordinates, skipped points, clipping to
+//! the visible range.
 
-use super::ticks::{self, Axis};
+use super::axis::{self as ticks, Axis};
+use super::style::{REF_COLOR, parse_color};
 use super::{Chart, PALETTE, Style};
-
-/// Colour of reference lines without an explicit colour.
-pub(super) const REF_COLOR: &str = "#555555";
+use plotters::style::RGBColor;
 
 /// A series or reference line prepared in transformed coordinates.
 pub(super) struct Trace {
     pub name: String,
-    pub color: String,
+    pub color: RGBColor,
     /// Reference line (drawn first, thinner, listed last in the legend).
     pub reference: bool,
     pub line: bool,
@@ -19,8 +18,8 @@ pub(super) struct Trace {
     pub marker: Option<usize>,
     /// Runs of consecutive plottable points (a skipped point breaks a run).
     pub runs: Vec<Vec<(f64, f64)>>,
-    /// Error bars: x, lower end (`None`: below a log axis), upper end.
-    pub errs: Vec<(f64, Option<f64>, f64)>,
+    /// Error bars: x, lower end (`None`: below a log axis), centre, upper end.
+    pub errs: Vec<(f64, Option<f64>, f64, f64)>,
 }
 
 /// Whether a log axis is still usable: some finite point has a positive
@@ -70,22 +69,25 @@ pub(super) fn prepare(chart: &Chart) -> (Vec<Trace>, bool, bool) {
     for (i, s) in chart.series.iter().enumerate() {
         let mut errs = Vec::new();
         for (&(x, y), &e) in s.points.iter().zip(s.y_err.iter().flatten()) {
-            let (Some(tx), Some(_)) = (ticks::transform(xlog, x), ticks::transform(ylog, y)) else {
+            let (Some(tx), Some(ty)) = (ticks::transform(xlog, x), ticks::transform(ylog, y))
+            else {
                 continue;
             };
             if !(e.is_finite() && e > 0.0) {
                 continue;
             }
             if let Some(hi) = ticks::transform(ylog, y + e) {
-                errs.push((tx, ticks::transform(ylog, y - e), hi));
+                errs.push((tx, ticks::transform(ylog, y - e), ty, hi));
             }
         }
         traces.push(Trace {
             name: s.name.clone(),
             color: s
                 .color
-                .clone()
-                .unwrap_or_else(|| PALETTE[i % PALETTE.len()].to_string()),
+                .as_deref()
+                .and_then(parse_color)
+                .or_else(|| parse_color(PALETTE[i % PALETTE.len()]))
+                .unwrap_or(REF_COLOR),
             reference: false,
             line: s.style.has_line(),
             dashed: s.style == Style::Dashed,
@@ -97,7 +99,11 @@ pub(super) fn prepare(chart: &Chart) -> (Vec<Trace>, bool, bool) {
     for l in &chart.lines {
         traces.push(Trace {
             name: l.name.clone(),
-            color: l.color.clone().unwrap_or_else(|| REF_COLOR.to_string()),
+            color: l
+                .color
+                .as_deref()
+                .and_then(parse_color)
+                .unwrap_or(REF_COLOR),
             reference: true,
             line: true,
             dashed: l.dashed,
@@ -109,100 +115,66 @@ pub(super) fn prepare(chart: &Chart) -> (Vec<Trace>, bool, bool) {
     (traces, xlog, ylog)
 }
 
-/// Pixel rectangle `[x0, x1] x [y0, y1]`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Rect {
-    pub x0: f64,
-    pub y0: f64,
-    pub x1: f64,
-    pub y1: f64,
-}
-
-impl Rect {
-    pub fn new(x: f64, y: f64, w: f64, h: f64) -> Self {
-        Rect {
-            x0: x,
-            y0: y,
-            x1: x + w,
-            y1: y + h,
-        }
-    }
-
-    pub fn contains(&self, (x, y): (f64, f64), margin: f64) -> bool {
-        x >= self.x0 - margin
-            && x <= self.x1 + margin
-            && y >= self.y0 - margin
-            && y <= self.y1 + margin
-    }
-
-    /// The part of segment `p`-`q` inside the rectangle (Liang-Barsky).
-    pub fn clip(&self, p: (f64, f64), q: (f64, f64)) -> Option<((f64, f64), (f64, f64))> {
-        let (dx, dy) = (q.0 - p.0, q.1 - p.1);
-        let (mut t0, mut t1) = (0.0f64, 1.0f64);
-        for (a, b) in [
-            (-dx, p.0 - self.x0),
-            (dx, self.x1 - p.0),
-            (-dy, p.1 - self.y0),
-            (dy, self.y1 - p.1),
-        ] {
-            if a == 0.0 {
-                if b < 0.0 {
-                    return None;
-                }
+/// Clips the segment `p`-`q` (transformed coordinates) to the visible
+/// rectangle of `xa` x `ya` (Liang-Barsky). Plotters clamps points outside
+/// the plot to its edge, which would bend the line, so segments are cut here.
+pub(super) fn clip(
+    xa: &Axis,
+    ya: &Axis,
+    p: (f64, f64),
+    q: (f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (a, b) in [
+        (-dx, p.0 - xa.lo),
+        (dx, xa.hi - p.0),
+        (-dy, p.1 - ya.lo),
+        (dy, ya.hi - p.1),
+    ] {
+        if a == 0.0 {
+            if b < 0.0 {
+                return None;
+            }
+        } else {
+            let t = b / a;
+            if a < 0.0 {
+                t0 = t0.max(t);
             } else {
-                let t = b / a;
-                if a < 0.0 {
-                    t0 = t0.max(t);
-                } else {
-                    t1 = t1.min(t);
-                }
-                if t0 > t1 {
-                    return None;
-                }
+                t1 = t1.min(t);
+            }
+            if t0 > t1 {
+                return None;
             }
         }
-        let at = |t: f64| (p.0 + t * dx, p.1 + t * dy);
-        Some((
-            if t0 > 0.0 { at(t0) } else { p },
-            if t1 < 1.0 { at(t1) } else { q },
-        ))
     }
-
-    /// Does the segment `p`-`q` touch the rectangle?
-    pub fn hits_segment(&self, p: (f64, f64), q: (f64, f64)) -> bool {
-        self.clip(p, q).is_some()
-    }
+    let at = |t: f64| (p.0 + t * dx, p.1 + t * dy);
+    Some((
+        if t0 > 0.0 { at(t0) } else { p },
+        if t1 < 1.0 { at(t1) } else { q },
+    ))
 }
 
-/// Maps transformed coordinates to pixels inside the plot rectangle.
-pub(super) struct Mapper {
-    pub plot: Rect,
-    pub xa: Axis,
-    pub ya: Axis,
+/// The visible parts of a run as polylines (transformed coordinates).
+pub(super) fn clip_run(xa: &Axis, ya: &Axis, run: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut pen: Option<(f64, f64)> = None;
+    for seg in run.windows(2) {
+        let Some((a, b)) = clip(xa, ya, seg[0], seg[1]) else {
+            pen = None;
+            continue;
+        };
+        match out.last_mut() {
+            Some(line) if pen == Some(a) => line.push(b),
+            _ => out.push(vec![a, b]),
+        }
+        pen = Some(b);
+    }
+    out
 }
 
-impl Mapper {
-    pub fn px(&self, tx: f64) -> f64 {
-        let v = self.plot.x0 + self.xa.frac(tx) * (self.plot.x1 - self.plot.x0);
-        v.clamp(-1e12, 1e12)
-    }
-
-    pub fn py(&self, ty: f64) -> f64 {
-        let v = self.plot.y1 - self.ya.frac(ty) * (self.plot.y1 - self.plot.y0);
-        v.clamp(-1e12, 1e12)
-    }
-
-    pub fn pt(&self, (tx, ty): (f64, f64)) -> (f64, f64) {
-        (self.px(tx), self.py(ty))
-    }
-
-    pub fn visible(&self, (tx, ty): (f64, f64)) -> bool {
-        let (fx, fy) = (self.xa.frac(tx), self.ya.frac(ty));
-        (-1e-9..=1.0 + 1e-9).contains(&fx) && (-1e-9..=1.0 + 1e-9).contains(&fy)
-    }
-
-    pub fn err_ends(&self, &(tx, lo, hi): &(f64, Option<f64>, f64)) -> (f64, Option<f64>, f64) {
-        let x = self.px(tx);
-        (x, lo.map(|t| self.py(t)), self.py(hi))
-    }
+/// Is the transformed point inside the visible range (with a little slack)?
+pub(super) fn visible(xa: &Axis, ya: &Axis, (x, y): (f64, f64)) -> bool {
+    let ok = |f: f64| (-1e-9..=1.0 + 1e-9).contains(&f);
+    ok(xa.frac(x)) && ok(ya.frac(y))
 }

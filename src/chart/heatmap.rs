@@ -1,46 +1,32 @@
 //! Heatmaps (colour maps) of gridded data, with contour lines.
 //!
-//! A [`Heatmap`] draws a grid of cell values in the viridis colour map with
+//! A [`Heatmap`] draws a grid of cell values in plotters' viridis colour map with
 //! a colour bar, optional iso-lines ([`Heatmap::contour`], by marching
-//! squares on the cell-centre grid) and an optional mask for cells without
+//! squares on the cell-centre grid; plotters has no contouring, so that
+//! kernel stays here) and an optional mask for cells without
 //! meaningful data (e.g. the inside of a magnet). Like [`Chart`](super::Chart)
 //! it never panics and renders deterministically.
 
 use std::collections::HashMap;
 use std::fmt;
 
-use super::ticks::{self, Axis};
+use plotters::style::RGBColor;
+use plotters::style::colors::colormaps::ViridisRGB;
+
+use super::axis::{self as ticks, Axis};
 
 #[path = "heatmap_draw.rs"]
 mod draw;
 
-/// Viridis at t = 0, 1/8, ..., 1 (matplotlib), linearly interpolated.
-const VIRIDIS: [[u8; 3]; 9] = [
-    [0x44, 0x01, 0x54],
-    [0x48, 0x24, 0x75],
-    [0x3b, 0x52, 0x8b],
-    [0x2c, 0x72, 0x8e],
-    [0x21, 0x91, 0x8c],
-    [0x28, 0xae, 0x80],
-    [0x5e, 0xc9, 0x62],
-    [0xad, 0xdc, 0x30],
-    [0xfd, 0xe7, 0x25],
-];
-
-/// Viridis colour at `t` in `[0, 1]` (clamped) as `#rrggbb`.
-fn viridis(t: f64) -> String {
-    let s = if t.is_finite() {
-        8.0 * t.clamp(0.0, 1.0)
+/// Viridis colour (plotters' colour map) at `t` in `[0, 1]` (clamped; NaN
+/// gives the low end).
+fn viridis(t: f64) -> RGBColor {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
     } else {
         0.0
     };
-    let k = (s.floor() as usize).min(7);
-    let f = s - k as f64;
-    let c = |n: usize| {
-        let (a, b) = (f64::from(VIRIDIS[k][n]), f64::from(VIRIDIS[k + 1][n]));
-        (a + f * (b - a)).round().clamp(0.0, 255.0) as u8
-    };
-    format!("#{:02x}{:02x}{:02x}", c(0), c(1), c(2))
+    ViridisRGB::get_color(t)
 }
 
 /// How cell values map to colours.
@@ -209,7 +195,11 @@ impl Heatmap {
     /// keeps the aspect ratio of the data ranges (clamped to 1:20).
     #[must_use]
     pub fn to_svg(&self, width: f64, height: f64) -> String {
-        draw::render(self, width, height)
+        let w = super::sanitize_size(width, 640.0);
+        let h = super::sanitize_size(height, 480.0);
+        super::render_svg(w, h, |root| {
+            let _ = draw::draw(self, root);
+        })
     }
 
     /// Cell geometry and values (missing, non-finite and masked cells NaN).
@@ -429,7 +419,7 @@ fn chains(segs: &[(Edge, Edge)]) -> Vec<(Vec<Edge>, bool)> {
 }
 
 /// Position of `v` on the colour axis in `[0, 1]`, `None` for "no data".
-fn colour_t(ca: Axis, v: f64) -> Option<f64> {
+fn colour_t(ca: &Axis, v: f64) -> Option<f64> {
     ticks::transform(ca.log, v)
         .map(|t| ca.frac(t).clamp(0.0, 1.0))
         .filter(|t| t.is_finite())

@@ -1,102 +1,95 @@
-//! Layout and drawing of a [`Heatmap`].
+//! Layout and drawing of a [`Heatmap`] with plotters: cells as rectangles,
+//! contours as paths, a colour bar as a second plotters chart.
 
-use std::fmt::Write as _;
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{Grid, Heatmap, VIRIDIS, chains, colour_t, march, viridis};
-use crate::chart::data::{Mapper, Rect};
-use crate::chart::svg::{self, DASH, num, text_width};
-use crate::chart::ticks::{self, Axis, Tick, Ticks};
+use super::{Grid, Heatmap, chains, colour_t, march, viridis};
+use crate::chart::axis::{self, Axis, PlotAxis, Ticks, text_width};
+use crate::chart::render::{Drawn, TICK_LEN};
+use crate::chart::style::{
+    FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, bold, clean, fit, font, sample_dashed, sample_solid,
+};
 
-// the line chart's type sizes and tick length
-use crate::chart::legend::FS_LEGEND;
-use crate::chart::render::{FS_LABEL, FS_TICK, FS_TITLE, TICK_LEN};
-/// Colour bar width and its distance from the plot.
+/// Colour bar width and its distance from the plot, px.
 const BAR_W: f64 = 14.0;
 const BAR_GAP: f64 = 14.0;
 /// Fill of cells without data (non-finite, missing, non-positive on a log scale).
-pub(super) const NO_DATA: &str = "#dddddd";
+pub(super) const NO_DATA: RGBColor = RGBColor(0xdd, 0xdd, 0xdd);
 /// Fill of masked cells.
-pub(super) const MASKED: &str = "#555555";
+pub(super) const MASKED: RGBColor = RGBColor(0x55, 0x55, 0x55);
 /// Stroke colour of contour lines.
-const CONTOUR: &str = "#111111";
-/// Dash patterns of successive contour levels (cycled).
-const DASHES: [Option<&str>; 4] = [None, Some(DASH), Some("2 3"), Some("9 3 2 3")];
+pub(super) const CONTOUR: RGBColor = RGBColor(0x11, 0x11, 0x11);
+/// Dash patterns `(on, off)` px of successive contour levels (cycled).
+const DASHES: [Option<(u32, u32)>; 4] = [None, Some((7, 4)), Some((2, 4)), Some((12, 4))];
 /// Plot aspect ratios beyond this factor are clamped (keeps plots usable).
 const MAX_ASPECT: f64 = 20.0;
+/// Colour steps of the colour bar.
+const BAR_STEPS: usize = 64;
 
-/// Renders `hm` as a standalone SVG document (see [`Heatmap::to_svg`]).
-pub(super) fn render(hm: &Heatmap, width: f64, height: f64) -> String {
-    let w = svg::sanitize_size(width, 640.0);
-    let h = svg::sanitize_size(height, 480.0);
-    let g = hm.grid();
-    let ca = hm.colour_axis(&g);
-    let lay = hm.layout(&g, ca, w, h);
-    let mut out = String::new();
-    svg::open_document(&mut out, w, h);
-    let any_colour = draw_cells(&mut out, &g, &lay.m, ca);
-    let has_no_data =
-        g.v.iter()
-            .zip(&g.masked)
-            .any(|(v, &m)| !m && colour_t(ca, *v).is_none());
-    hm.draw_contours(&mut out, &g, &lay.m);
-    draw_axes(&mut out, &lay);
-    hm.draw_bar(&mut out, &lay);
-    hm.draw_labels(&mut out, &lay, w);
-    hm.draw_legend(&mut out, &lay.m.plot, has_no_data);
-    if !any_colour {
-        let p = &lay.m.plot;
-        let (cx, cy) = ((p.x0 + p.x1) / 2.0, (p.y0 + p.y1) / 2.0);
-        svg::text(
-            &mut out,
-            cx,
-            cy,
-            FS_LABEL,
-            "middle",
-            " fill-opacity=\"0.6\"",
-            "no data",
-        );
-    }
-    out.push_str("</svg>\n");
-    out
+/// Plot rectangle (px), label area sizes and ticks of the plot and bar.
+struct Layout {
+    x0: f64,
+    y0: f64,
+    pw: f64,
+    ph: f64,
+    y_area: f64,
+    x_area: f64,
+    bar_area: f64,
+    xt: Ticks,
+    yt: Ticks,
+    ct: Ticks,
 }
 
 impl Heatmap {
     /// Plot rectangle (centred, keeping the data aspect ratio), colour bar
-    /// and ticks for a `w` x `h` document.
-    fn layout(&self, g: &Grid, ca: Axis, w: f64, h: f64) -> Layout {
+    /// and ticks for a `w` x `h` px document.
+    fn layout(&self, g: &Grid, ca: &Axis, w: f64, h: f64) -> Layout {
         let has = |s: &str| !s.trim().is_empty();
         let top = if has(&self.title) {
             24.0 + FS_TITLE
         } else {
             14.0
         };
-        let x_label_h = if has(&self.x_label) {
-            8.0 + FS_LABEL
-        } else {
-            0.0
-        };
-        let bottom = TICK_LEN + 4.0 + FS_TICK + x_label_h + 10.0;
-        let ah = (h - top - bottom).max(10.0);
+        let x_area = f64::from(TICK_LEN)
+            + 6.0
+            + FS_TICK
+            + if has(&self.x_label) {
+                8.0 + FS_LABEL
+            } else {
+                0.0
+            }
+            + 4.0;
+        let ah = (h - top - x_area - 6.0).max(10.0);
         let max_w = |t: &Ticks| {
             t.major
                 .iter()
-                .map(|t| text_width(&t.label, FS_TICK))
+                .map(|t| text_width(&t.1, FS_TICK))
                 .fold(0.0, f64::max)
         };
         let y_lab = if has(&self.y_label) {
-            FS_LABEL + 8.0
+            FS_LABEL + 10.0
         } else {
             0.0
         };
-        let left = 8.0 + y_lab + max_w(&fit_ticks(&g.ya, ah, false)) + 4.0 + TICK_LEN;
+        let y_area = 8.0
+            + y_lab
+            + max_w(&axis::choose_ticks(&g.ya, ah, false, FS_TICK))
+            + 6.0
+            + f64::from(TICK_LEN);
         let c_lab = if has(&self.colour_label) {
-            8.0 + FS_LABEL
+            10.0 + FS_LABEL
         } else {
             0.0
         };
-        let right =
-            BAR_GAP + BAR_W + TICK_LEN + 4.0 + max_w(&fit_ticks(&ca, ah, false)) + c_lab + 10.0;
-        let aw = (w - left - right).max(10.0);
+        let bar_area = f64::from(TICK_LEN)
+            + 6.0
+            + max_w(&axis::choose_ticks(ca, ah, false, FS_TICK))
+            + c_lab
+            + 8.0;
+        let aw = (w - y_area - BAR_GAP - BAR_W - bar_area).max(10.0);
         let r = ((g.xa.hi - g.xa.lo) / (g.ya.hi - g.ya.lo)).clamp(1.0 / MAX_ASPECT, MAX_ASPECT);
         let (pw, ph) = if aw / ah > r {
             (ah * r, ah)
@@ -104,339 +97,252 @@ impl Heatmap {
             (aw, aw / r)
         };
         let (pw, ph) = (pw.max(10.0), ph.max(10.0));
-        let plot = Rect::new(left + (aw - pw) / 2.0, top + (ah - ph) / 2.0, pw, ph);
         Layout {
-            m: Mapper {
-                plot,
-                xa: g.xa,
-                ya: g.ya,
-            },
-            xt: fit_ticks(&g.xa, pw, true),
-            yt: fit_ticks(&g.ya, ph, false),
-            ct: fit_ticks(&ca, ph, false),
-            ca,
-            bar: Rect::new(plot.x1 + BAR_GAP, plot.y0, BAR_W, ph),
+            x0: y_area + (aw - pw) / 2.0,
+            y0: top + (ah - ph) / 2.0,
+            pw,
+            ph,
+            y_area,
+            x_area,
+            bar_area,
+            xt: axis::choose_ticks(&g.xa, pw, true, FS_TICK),
+            yt: axis::choose_ticks(&g.ya, ph, false, FS_TICK),
+            ct: axis::choose_ticks(ca, ph, false, FS_TICK),
         }
     }
+}
 
-    /// Contour paths: a white halo under a dark line, chained into polylines.
-    fn draw_contours(&self, out: &mut String, g: &Grid, m: &Mapper) {
-        if self.contours.is_empty() {
-            return;
-        }
-        out.push_str("<g fill=\"none\" stroke-linejoin=\"round\" stroke-linecap=\"round\">\n");
+/// Draws `hm` on `root` (see [`Heatmap::to_svg`]).
+pub(super) fn draw<DB: DrawingBackend>(hm: &Heatmap, root: &DrawingArea<DB, Shift>) -> Drawn<DB> {
+    let (w, h) = root.dim_in_pixel();
+    let g = hm.grid();
+    let ca = hm.colour_axis(&g);
+    let lay = hm.layout(&g, &ca, f64::from(w), f64::from(h));
+    let px = |v: f64| v.round() as i32;
+    let title = hm.title.trim();
+    if !title.is_empty() {
+        let text = fit(title, f64::from(w) - 16.0, FS_TITLE);
+        let half = text_width(&text, FS_TITLE) / 2.0;
+        let cx = (lay.x0 + lay.pw / 2.0)
+            .min(f64::from(w) - 8.0 - half)
+            .max(8.0 + half);
+        let style = bold(FS_TITLE)
+            .color(&INK)
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        root.draw(&Text::new(
+            text,
+            (px(cx), px(lay.y0 - 10.0 - FS_TITLE / 2.0)),
+            style,
+        ))?;
+    }
+    let main = root.clone().shrink(
+        (px(lay.x0 - lay.y_area), px(lay.y0)),
+        (px(lay.y_area + lay.pw), px(lay.ph + lay.x_area)),
+    );
+    let mut ctx = ChartBuilder::on(&main)
+        .x_label_area_size(px(lay.x_area))
+        .y_label_area_size(px(lay.y_area))
+        .build_cartesian_2d(PlotAxis::new(&g.xa, &lay.xt), PlotAxis::new(&g.ya, &lay.yt))?;
+    let x_fmt = |v: &f64| axis::label_of(&g.xa, &lay.xt, *v);
+    let y_fmt = |v: &f64| axis::label_of(&g.ya, &lay.yt, *v);
+    ctx.configure_mesh()
+        .disable_mesh()
+        .x_desc(clean(&hm.x_label))
+        .y_desc(clean(&hm.y_label))
+        .axis_desc_style(font(FS_LABEL).color(&INK))
+        .label_style(font(FS_TICK).color(&INK))
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .axis_style(FRAME)
+        .set_all_tick_mark_size(TICK_LEN)
+        .draw()?;
+    let any_colour = draw_cells(&mut ctx, &g, &ca)?;
+    let frame = [(g.xa.lo, g.ya.lo), (g.xa.hi, g.ya.hi)];
+    ctx.plotting_area()
+        .draw(&Rectangle::new(frame, FRAME.stroke_width(1)))?;
+    hm.draw_contours(&mut ctx, &g)?;
+    if !any_colour {
+        let style = font(FS_LABEL)
+            .color(&INK.mix(0.6))
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        let mid = ((g.xa.lo + g.xa.hi) / 2.0, (g.ya.lo + g.ya.hi) / 2.0);
+        ctx.plotting_area()
+            .draw(&Text::new("no data", mid, style))?;
+    }
+    let has_no_data =
+        g.v.iter()
+            .zip(&g.masked)
+            .any(|(v, &m)| !m && colour_t(&ca, *v).is_none());
+    hm.draw_legend(&mut ctx, lay.pw, lay.ph, has_no_data)?;
+    let bar = root.clone().shrink(
+        (px(lay.x0 + lay.pw + BAR_GAP), px(lay.y0)),
+        (px(BAR_W + lay.bar_area), px(lay.ph)),
+    );
+    hm.draw_bar(&bar, &ca, &lay)
+}
+
+impl Heatmap {
+    /// Contours: a white halo under a dark line, chained into polylines.
+    fn draw_contours<DB: DrawingBackend>(
+        &self,
+        ctx: &mut ChartContext<'_, DB, Cartesian2d<PlotAxis, PlotAxis>>,
+        g: &Grid,
+    ) -> Drawn<DB> {
+        let halo = WHITE.mix(0.7).stroke_width(4);
         for (k, (level, _)) in self.contours.iter().enumerate() {
-            let mut d = String::new();
+            let line = CONTOUR.stroke_width(2);
             for (chain, closed) in chains(&march(g, *level)) {
-                for (n, &e) in chain.iter().enumerate() {
-                    let (x, y) = m.pt(g.edge_point(e, *level));
-                    let _ = write!(d, "{}{} {}", if n == 0 { 'M' } else { 'L' }, num(x), num(y));
-                }
+                let mut pts: Vec<(f64, f64)> =
+                    chain.iter().map(|&e| g.edge_point(e, *level)).collect();
                 if closed {
-                    d.push('Z');
+                    pts.extend(pts.first().copied());
+                }
+                ctx.plotting_area()
+                    .draw(&PathElement::new(pts.clone(), halo))?;
+                match DASHES[k % DASHES.len()] {
+                    None => ctx.plotting_area().draw(&PathElement::new(pts, line))?,
+                    Some((on, off)) => ctx
+                        .draw_series(DashedLineSeries::new(pts, on, off, line))
+                        .map(|_| ())?,
                 }
             }
-            if d.is_empty() {
-                continue;
-            }
-            let dash = DASHES[k % DASHES.len()]
-                .map(|s| format!(" stroke-dasharray=\"{s}\""))
-                .unwrap_or_default();
-            let _ = writeln!(
-                out,
-                "<path class=\"contour-halo\" d=\"{d}\" stroke=\"#ffffff\" stroke-opacity=\"0.7\" stroke-width=\"3.4\"/>"
-            );
-            let _ = writeln!(
-                out,
-                "<path class=\"contour\" d=\"{d}\" stroke=\"{CONTOUR}\" stroke-width=\"1.5\"{dash}/>"
-            );
         }
-        out.push_str("</g>\n");
-    }
-
-    /// Colour bar (gradient), its ticks and labels, and contour level marks.
-    fn draw_bar(&self, out: &mut String, lay: &Layout) {
-        let b = &lay.bar;
-        out.push_str("<defs><linearGradient id=\"hm-cbar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">");
-        for k in 0..VIRIDIS.len() {
-            let t = k as f64 / (VIRIDIS.len() - 1) as f64;
-            let _ = write!(
-                out,
-                "<stop offset=\"{}\" stop-color=\"{}\"/>",
-                num(t),
-                viridis(t)
-            );
-        }
-        out.push_str("</linearGradient></defs>\n");
-        rect(out, b, " fill=\"url(#hm-cbar)\"");
-        let py = |t: f64| b.y1 - lay.ca.frac(t).clamp(0.0, 1.0) * (b.y1 - b.y0);
-        let mut marks = String::new();
-        for (level, _) in &self.contours {
-            if let Some(t) = ticks::transform(lay.ca.log, *level)
-                .filter(|&t| (lay.ca.lo..=lay.ca.hi).contains(&t))
-            {
-                let _ = write!(marks, "M{} {}h{}", num(b.x0), num(py(t)), num(BAR_W));
-            }
-        }
-        svg::path(out, &marks, CONTOUR, 1.5, None);
-        rect(out, b, FRAME);
-        let mut d = String::new();
-        for t in &lay.ct.major {
-            let _ = write!(d, "M{} {}h{}", num(b.x1), num(py(t.pos)), num(TICK_LEN));
-        }
-        svg::path(out, &d, "#444444", 1.0, None);
-        let mut d = String::new();
-        for &t in &lay.ct.minor {
-            let _ = write!(d, "M{} {}h3", num(b.x1), num(py(t)));
-        }
-        svg::path(out, &d, "#444444", 0.7, None);
-        let lx = b.x1 + TICK_LEN + 4.0;
-        for t in &lay.ct.major {
-            svg::text(out, lx, py(t.pos), FS_TICK, "start", "", &t.label);
-        }
-        let label = self.colour_label.trim();
-        if !label.is_empty() {
-            let label = svg::truncate_to_width(label, (b.y1 - b.y0).max(40.0), FS_LABEL);
-            let lw = lay
-                .ct
-                .major
-                .iter()
-                .map(|t| text_width(&t.label, FS_TICK))
-                .fold(0.0, f64::max);
-            let (cx, cy) = (lx + lw + 8.0 + FS_LABEL / 2.0, (b.y0 + b.y1) / 2.0);
-            let rot = format!(" transform=\"rotate(-90 {} {})\"", num(cx), num(cy));
-            svg::text(out, cx, cy, FS_LABEL, "middle", &rot, &label);
-        }
-    }
-
-    /// Title and axis labels, positioned relative to the plot.
-    fn draw_labels(&self, out: &mut String, lay: &Layout, w: f64) {
-        let p = &lay.m.plot;
-        let x_label = self.x_label.trim();
-        if !x_label.is_empty() {
-            let label = svg::truncate_to_width(x_label, w - 16.0, FS_LABEL);
-            let y = p.y1 + TICK_LEN + 4.0 + FS_TICK + 8.0 + FS_LABEL / 2.0;
-            svg::text(out, (p.x0 + p.x1) / 2.0, y, FS_LABEL, "middle", "", &label);
-        }
-        let y_label = self.y_label.trim();
-        if !y_label.is_empty() {
-            let label = svg::truncate_to_width(y_label, (p.y1 - p.y0).max(40.0), FS_LABEL);
-            let lw = lay
-                .yt
-                .major
-                .iter()
-                .map(|t| text_width(&t.label, FS_TICK))
-                .fold(0.0, f64::max);
-            let (cx, cy) = (
-                p.x0 - TICK_LEN - 4.0 - lw - 8.0 - FS_LABEL / 2.0,
-                (p.y0 + p.y1) / 2.0,
-            );
-            let rot = format!(" transform=\"rotate(-90 {} {})\"", num(cx), num(cy));
-            svg::text(out, cx, cy, FS_LABEL, "middle", &rot, &label);
-        }
-        let title = self.title.trim();
-        if !title.is_empty() {
-            let title = svg::truncate_to_width(title, w - 16.0, FS_TITLE);
-            let half = text_width(&title, FS_TITLE) / 2.0;
-            let cx = ((p.x0 + p.x1) / 2.0).min(w - 8.0 - half).max(8.0 + half);
-            let bold = " font-weight=\"bold\"";
-            svg::text(
-                out,
-                cx,
-                p.y0 - 10.0 - FS_TITLE / 2.0,
-                FS_TITLE,
-                "middle",
-                bold,
-                &title,
-            );
-        }
+        Ok(())
     }
 
     /// Legend (contour labels, "no data" swatch) in the top-right plot corner.
-    fn draw_legend(&self, out: &mut String, p: &Rect, has_no_data: bool) {
-        const PAD: f64 = 6.0;
-        const ROW: f64 = FS_LEGEND * 1.5;
-        const SAMPLE: f64 = 24.0;
-        let max_text = 0.45 * (p.x1 - p.x0);
+    fn draw_legend<'a, DB: DrawingBackend + 'a>(
+        &self,
+        ctx: &mut ChartContext<'a, DB, Cartesian2d<PlotAxis, PlotAxis>>,
+        pw: f64,
+        ph: f64,
+        has_no_data: bool,
+    ) -> Drawn<DB> {
         let mut rows: Vec<(Option<usize>, String)> = self
             .contours
             .iter()
             .enumerate()
             .filter(|(_, (_, l))| !l.trim().is_empty())
-            .map(|(k, (_, l))| {
-                (
-                    Some(k),
-                    svg::truncate_to_width(l.trim(), max_text, FS_LEGEND),
-                )
-            })
+            .map(|(k, (_, l))| (Some(k), fit(l, 0.45 * pw, FS_TICK)))
             .collect();
         if has_no_data {
             rows.push((None, "no data".to_string()));
         }
-        let max_rows = ((p.y1 - p.y0 - 16.0 - 2.0 * PAD) / ROW).floor().max(0.0) as usize;
-        rows.truncate(max_rows);
+        rows.truncate(((ph - 24.0) / (FS_TICK * 1.6)).floor().max(0.0) as usize);
         if rows.is_empty() {
-            return;
+            return Ok(());
         }
-        let text_w = rows
-            .iter()
-            .map(|(_, s)| text_width(s, FS_LEGEND))
-            .fold(0.0, f64::max);
-        let (bw, bh) = (
-            3.0 * PAD + SAMPLE + text_w,
-            2.0 * PAD + rows.len() as f64 * ROW,
-        );
-        let (x, y) = (p.x1 - 8.0 - bw, p.y0 + 8.0);
-        out.push_str("<g>\n");
-        let white =
-            " fill=\"#ffffff\" fill-opacity=\"0.85\" stroke=\"#999999\" stroke-width=\"0.8\"";
-        rect(out, &Rect::new(x, y, bw, bh), white);
-        for (n, (k, name)) in rows.iter().enumerate() {
-            let cy = y + PAD + (n as f64 + 0.5) * ROW;
+        for (k, name) in rows {
+            let anno = ctx.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
+            anno.label(name);
             match k {
                 Some(k) => {
-                    let d = format!("M{} {}h{}", num(x + PAD), num(cy), num(SAMPLE));
-                    svg::path(out, &d, CONTOUR, 1.5, DASHES[k % DASHES.len()]);
+                    let style = CONTOUR.stroke_width(2);
+                    match DASHES[k % DASHES.len()] {
+                        None => anno.legend(move |at| EmptyElement::at(at) + sample_solid(style)),
+                        Some(d) => {
+                            anno.legend(move |at| EmptyElement::at(at) + sample_dashed(style, d))
+                        }
+                    };
                 }
                 None => {
-                    let grey =
-                        format!(" fill=\"{NO_DATA}\" stroke=\"#999999\" stroke-width=\"0.6\"");
-                    rect(out, &Rect::new(x + PAD, cy - 4.0, SAMPLE, 8.0), &grey);
+                    anno.legend(|at| {
+                        let swatch = [(0, -4), (24, 4)];
+                        EmptyElement::at(at)
+                            + Rectangle::new(swatch, NO_DATA.filled())
+                            + Rectangle::new(swatch, RGBColor(0x99, 0x99, 0x99))
+                    });
                 }
             }
-            svg::text(
-                out,
-                x + 2.0 * PAD + SAMPLE,
-                cy,
-                FS_LEGEND,
-                "start",
-                "",
-                name,
-            );
         }
-        out.push_str("</g>\n");
+        ctx.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .margin(6)
+            .legend_area_size(32)
+            .label_font(font(FS_TICK).color(&INK))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(0x99, 0x99, 0x99))
+            .draw()
+    }
+
+    /// Colour bar: colour steps, contour level marks, ticks and label.
+    fn draw_bar<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        ca: &Axis,
+        lay: &Layout,
+    ) -> Drawn<DB> {
+        let mut bar = ChartBuilder::on(area)
+            .right_y_label_area_size(lay.bar_area.round() as i32)
+            .build_cartesian_2d(RangedCoordf64::from(0.0..1.0), PlotAxis::new(ca, &lay.ct))?;
+        let c_fmt = |v: &f64| axis::label_of(ca, &lay.ct, *v);
+        bar.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc(clean(&self.colour_label))
+            .axis_desc_style(font(FS_LABEL).color(&INK))
+            .label_style(font(FS_TICK).color(&INK))
+            .y_label_formatter(&c_fmt)
+            .axis_style(FRAME)
+            .set_all_tick_mark_size(TICK_LEN)
+            .draw()?;
+        let step = (ca.hi - ca.lo) / BAR_STEPS as f64;
+        bar.draw_series((0..BAR_STEPS).map(|k| {
+            let (t0, t1) = (ca.lo + k as f64 * step, ca.lo + (k + 1) as f64 * step);
+            let colour = viridis((k as f64 + 0.5) / BAR_STEPS as f64);
+            Rectangle::new([(0.0, ca.data(t0)), (1.0, ca.data(t1))], colour.filled())
+        }))?;
+        for (level, _) in &self.contours {
+            if let Some(t) = axis::transform(ca.log, *level).filter(|t| (ca.lo..=ca.hi).contains(t))
+            {
+                let y = ca.data(t);
+                bar.plotting_area().draw(&PathElement::new(
+                    vec![(0.0, y), (1.0, y)],
+                    CONTOUR.stroke_width(2),
+                ))?;
+            }
+        }
+        let frame = [(0.0, ca.data(ca.lo)), (1.0, ca.data(ca.hi))];
+        bar.plotting_area()
+            .draw(&Rectangle::new(frame, FRAME.stroke_width(1)))
     }
 }
 
 /// Cell rectangles, runs of equal colour in a row merged (colours are
 /// quantised to 256 levels). Returns whether any cell got a colour.
-fn draw_cells(out: &mut String, g: &Grid, m: &Mapper, ca: Axis) -> bool {
-    let round = |v: f64| (v * 100.0).round() / 100.0;
-    let xe: Vec<f64> = (0..=g.nx)
-        .map(|i| round(m.px(g.x0 + i as f64 * g.dx)))
-        .collect();
-    let ye: Vec<f64> = (0..=g.ny)
-        .map(|j| round(m.py(g.y0 + j as f64 * g.dy)))
-        .collect();
-    let fill = |i: usize, j: usize| -> Option<u8> {
-        let k = j * g.nx + i;
+fn draw_cells<DB: DrawingBackend>(
+    ctx: &mut ChartContext<'_, DB, Cartesian2d<PlotAxis, PlotAxis>>,
+    g: &Grid,
+    ca: &Axis,
+) -> Result<bool, DrawingAreaErrorKind<DB::ErrorType>> {
+    let fill = |k: usize| -> Option<u8> {
         colour_t(ca, g.v[k])
             .map(|t| (t * 255.0).round() as u8)
             .filter(|_| !g.masked[k])
     };
     let mut any = false;
-    out.push_str("<g shape-rendering=\"crispEdges\">\n");
+    let mut cells = Vec::new();
     for j in 0..g.ny {
-        let (y0, y1) = (ye[j].min(ye[j + 1]), ye[j].max(ye[j + 1]));
+        let (y0, y1) = (g.y0 + j as f64 * g.dy, g.y0 + (j + 1) as f64 * g.dy);
         let mut i = 0;
         while i < g.nx {
-            let (f, masked) = (fill(i, j), g.masked[j * g.nx + i]);
+            let at = j * g.nx + i;
+            let (f, masked) = (fill(at), g.masked[at]);
             let mut k = i + 1;
-            while k < g.nx && fill(k, j) == f && g.masked[j * g.nx + k] == masked {
+            while k < g.nx && fill(j * g.nx + k) == f && g.masked[j * g.nx + k] == masked {
                 k += 1;
             }
             let colour = match f {
                 Some(q) => viridis(f64::from(q) / 255.0),
-                None if masked => MASKED.to_string(),
-                None => NO_DATA.to_string(),
+                None if masked => MASKED,
+                None => NO_DATA,
             };
             any |= f.is_some();
-            let (x0, x1) = (xe[i].min(xe[k]), xe[i].max(xe[k]));
-            rect(
-                out,
-                &Rect { x0, y0, x1, y1 },
-                &format!(" fill=\"{colour}\""),
-            );
+            let (x0, x1) = (g.x0 + i as f64 * g.dx, g.x0 + k as f64 * g.dx);
+            cells.push(Rectangle::new([(x0, y0), (x1, y1)], colour.filled()));
             i = k;
         }
     }
-    out.push_str("</g>\n");
-    any
-}
-
-/// Pixel mapping of the plot, ticks of both axes and the colour bar.
-struct Layout {
-    m: Mapper,
-    xt: Ticks,
-    yt: Ticks,
-    ct: Ticks,
-    ca: Axis,
-    bar: Rect,
-}
-
-/// The densest ticks (at most 8 labels) whose labels do not overlap along
-/// an axis of `len` pixels.
-fn fit_ticks(axis: &Axis, len: f64, horizontal: bool) -> Ticks {
-    let fits = |majors: &[Tick]| {
-        majors.windows(2).all(|w| {
-            let gap = ((axis.frac(w[1].pos) - axis.frac(w[0].pos)) * len).abs();
-            if horizontal {
-                gap >= (text_width(&w[0].label, FS_TICK) + text_width(&w[1].label, FS_TICK)) / 2.0
-                    + 8.0
-            } else {
-                gap >= FS_TICK * 1.6
-            }
-        })
-    };
-    let minor = axis.log && len / (axis.hi - axis.lo) >= 40.0;
-    (3..=8)
-        .rev()
-        .map(|n| ticks::axis_ticks(axis, n, minor))
-        .find(|t| fits(&t.major))
-        .unwrap_or_else(|| ticks::axis_ticks(axis, 2, minor))
-}
-
-/// Frame, tick marks and tick labels of the plot.
-fn draw_axes(out: &mut String, lay: &Layout) {
-    let (m, p) = (&lay.m, &lay.m.plot);
-    rect(out, p, FRAME);
-    let mut d = String::new();
-    for t in &lay.xt.major {
-        let _ = write!(d, "M{} {}v{}", num(m.px(t.pos)), num(p.y1), num(TICK_LEN));
-    }
-    for t in &lay.yt.major {
-        let _ = write!(d, "M{} {}h{}", num(p.x0), num(m.py(t.pos)), num(-TICK_LEN));
-    }
-    svg::path(out, &d, "#444444", 1.0, None);
-    let y = p.y1 + TICK_LEN + 4.0 + FS_TICK / 2.0;
-    for t in &lay.xt.major {
-        svg::text(out, m.px(t.pos), y, FS_TICK, "middle", "", &t.label);
-    }
-    for t in &lay.yt.major {
-        svg::text(
-            out,
-            p.x0 - TICK_LEN - 4.0,
-            m.py(t.pos),
-            FS_TICK,
-            "end",
-            "",
-            &t.label,
-        );
-    }
-}
-
-/// Style of the plot and colour bar frames.
-const FRAME: &str = " fill=\"none\" stroke=\"#444444\" stroke-width=\"1\"";
-
-/// Appends a `<rect>` covering `r`; `extra` (starting with a space) goes
-/// into the tag verbatim.
-fn rect(out: &mut String, r: &Rect, extra: &str) {
-    let _ = writeln!(
-        out,
-        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"{extra}/>",
-        num(r.x0),
-        num(r.y0),
-        num(r.x1 - r.x0),
-        num(r.y1 - r.y0)
-    );
+    ctx.draw_series(cells)?;
+    Ok(any)
 }

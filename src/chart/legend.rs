@@ -1,158 +1,191 @@
-//! Legend layout, placement (avoiding the data) and drawing.
+//! Legend entries, placement (a corner clear of the data, else outside)
+//! and drawing through plotters' series labels.
 
-use std::fmt::Write as _;
+use plotters::coord::ranged1d::Ranged;
+use plotters::prelude::*;
 
-use super::LegendPosition;
-use super::data::{Mapper, Rect, Trace};
-use super::svg::{self, DASH, MARKER_R, escape_xml, num, text_width};
+use super::axis::{Axis, text_width};
+use super::data::{self, Trace};
+use super::render::Drawn;
+use super::style::{DASH, FS_TICK, INK, fit, font, sample_dashed, sample_marker, sample_solid};
 
-/// Legend font size.
-pub(crate) const FS_LEGEND: f64 = 11.0;
-/// Inner padding of the legend box.
-pub(super) const PAD: f64 = 6.0;
-/// Height of one legend row.
-const ROW: f64 = FS_LEGEND * 1.5;
-/// Length of the line sample in front of each name.
-pub(super) const SAMPLE: f64 = 26.0;
-/// Gap between sample and name.
-pub(super) const GAP: f64 = 6.0;
-/// Distance between an inside legend and the plot frame.
-const INSET: f64 = 8.0;
+/// Inner margin of the legend box, px.
+const MARGIN: f64 = 6.0;
+/// Width plotters reserves for the line sample in front of each name, px.
+const SAMPLE: f64 = 32.0;
+/// Sample, margins and gap around the names, px.
+pub(super) const SAMPLE_AREA: f64 = SAMPLE + 2.0 * MARGIN;
+/// Height of one legend row, px.
+const ROW: f64 = FS_TICK * 1.6;
+/// Distance plotters keeps between an inside legend and the frame, px.
+const INSET: f64 = 5.0;
 
-/// Legend rows (trace indices, then maybe a "+N more" row) and box size.
+/// Where the legend goes.
+#[derive(Clone)]
+pub(super) enum Placement {
+    /// Inside the plot, at this corner.
+    Corner(SeriesLabelPosition),
+    /// Right of the plot.
+    Outside,
+}
+
+/// Legend rows (trace index and shortened name; `None` for the "+N more"
+/// row) and box size, px.
 pub(super) struct Legend {
-    rows: Vec<usize>,
-    names: Vec<String>,
+    rows: Vec<(Option<usize>, String)>,
     pub w: f64,
     pub h: f64,
 }
 
 impl Legend {
-    /// Lays out entries for every named trace, or `None` if there are none.
-    /// Names are truncated to `max_text` pixels; rows beyond what fits in a
-    /// chart of height `h` are summarised as "+N more".
-    pub fn new(traces: &[Trace], h: f64, max_text: f64) -> Option<Legend> {
-        let mut rows: Vec<usize> = (0..traces.len())
+    /// Entries for every named trace, or `None` if there are none. Names are
+    /// shortened to `max_text` px; rows beyond what fits in `plot_h` px are
+    /// summarised as "+N more".
+    pub fn new(traces: &[Trace], plot_h: f64, max_text: f64) -> Option<Legend> {
+        let named: Vec<usize> = (0..traces.len())
             .filter(|&i| !traces[i].name.trim().is_empty())
             .collect();
-        if rows.is_empty() {
+        if named.is_empty() {
             return None;
         }
-        let max_rows = (((h - 40.0 - 2.0 * PAD) / ROW).floor() as usize).max(2);
-        let mut more = 0;
-        if rows.len() > max_rows {
-            more = rows.len() - (max_rows - 1);
-            rows.truncate(max_rows - 1);
-        }
-        let mut names: Vec<String> = rows
+        let max_rows = (((plot_h - 2.0 * INSET - 2.0 * MARGIN) / ROW).floor() as usize).max(2);
+        let keep = if named.len() > max_rows {
+            max_rows - 1
+        } else {
+            named.len()
+        };
+        let mut rows: Vec<(Option<usize>, String)> = named[..keep]
             .iter()
-            .map(|&i| svg::truncate_to_width(traces[i].name.trim(), max_text, FS_LEGEND))
+            .map(|&i| (Some(i), fit(&traces[i].name, max_text, FS_TICK)))
             .collect();
-        if more > 0 {
-            names.push(format!("+{more} more"));
+        if keep < named.len() {
+            rows.push((None, format!("+{} more", named.len() - keep)));
         }
-        let text_w = names
+        let text_w = rows
             .iter()
-            .map(|n| text_width(n, FS_LEGEND))
+            .map(|r| text_width(&r.1, FS_TICK))
             .fold(0.0, f64::max);
         Some(Legend {
-            w: 2.0 * PAD + SAMPLE + GAP + text_w,
-            h: 2.0 * PAD + names.len() as f64 * ROW,
+            w: SAMPLE_AREA + text_w,
+            h: 2.0 * MARGIN + rows.len() as f64 * ROW,
             rows,
-            names,
         })
     }
 
-    /// The box at an inside corner of `plot` (`Auto`, `Outside` and `Hidden`
-    /// mean top-right here).
-    pub fn corner(&self, pos: LegendPosition, plot: &Rect) -> Rect {
-        let (l, r) = (plot.x0 + INSET, plot.x1 - INSET - self.w);
-        let (t, b) = (plot.y0 + INSET, plot.y1 - INSET - self.h);
-        let (x, y) = match pos {
-            LegendPosition::TopLeft => (l, t),
-            LegendPosition::BottomRight => (r, b),
-            LegendPosition::BottomLeft => (l, b),
-            _ => (r, t),
-        };
-        Rect::new(x, y, self.w, self.h)
-    }
-
     /// Inside corners in order of preference (top-right, top-left,
-    /// bottom-right, bottom-left): the first one covering no data if the
-    /// legend fits inside at all, and the least crowded one.
-    pub fn corners(&self, traces: &[Trace], m: &Mapper) -> (Option<Rect>, Rect) {
-        let p = &m.plot;
-        let fits = self.w + 2.0 * INSET <= p.x1 - p.x0 && self.h + 2.0 * INSET <= p.y1 - p.y0;
-        let scored: Vec<(usize, Rect)> = [
-            LegendPosition::TopRight,
-            LegendPosition::TopLeft,
-            LegendPosition::BottomRight,
-            LegendPosition::BottomLeft,
+    /// bottom-right, bottom-left) for a `plot_w` x `plot_h` px plot: the
+    /// first covering no data if the legend fits at all, and the least
+    /// crowded one.
+    pub fn corners(
+        &self,
+        traces: &[Trace],
+        xa: &Axis,
+        ya: &Axis,
+        plot_w: f64,
+        plot_h: f64,
+    ) -> (Option<SeriesLabelPosition>, SeriesLabelPosition) {
+        use SeriesLabelPosition::{LowerLeft, LowerRight, UpperLeft, UpperRight};
+        let fits = self.w + 2.0 * INSET <= plot_w && self.h + 2.0 * INSET <= plot_h;
+        let (fw, fh) = ((self.w + INSET) / plot_w, (self.h + INSET) / plot_h);
+        let span = |a: &Axis, f0: f64, f1: f64| Axis {
+            log: false,
+            lo: a.lo + f0 * (a.hi - a.lo),
+            hi: a.lo + f1 * (a.hi - a.lo),
+        };
+        let scored: Vec<(usize, SeriesLabelPosition)> = [
+            (UpperRight, true, true),
+            (UpperLeft, false, true),
+            (LowerRight, true, false),
+            (LowerLeft, false, false),
         ]
         .into_iter()
-        .map(|c| self.corner(c, p))
-        .map(|r| (data_hits(traces, m, &r), r))
+        .map(|(pos, right, top)| {
+            let bx = if right {
+                span(xa, 1.0 - fw, 1.0)
+            } else {
+                span(xa, 0.0, fw)
+            };
+            let by = if top {
+                span(ya, 1.0 - fh, 1.0)
+            } else {
+                span(ya, 0.0, fh)
+            };
+            (data_hits(traces, &bx, &by), pos)
+        })
         .collect();
-        let clear = scored.iter().find(|(n, _)| *n == 0).filter(|_| fits);
+        let clear = scored
+            .iter()
+            .find(|s| s.0 == 0)
+            .filter(|_| fits)
+            .map(|s| s.1.clone());
         let least = scored
             .iter()
-            .min_by_key(|(n, _)| *n)
-            .map_or(scored[0].1, |s| s.1);
-        (clear.map(|s| s.1), least)
+            .min_by_key(|s| s.0)
+            .map_or(UpperRight, |s| s.1.clone());
+        (clear, least)
     }
 
-    /// Draws the legend box at `r`.
-    pub fn draw(&self, out: &mut String, traces: &[Trace], r: Rect) {
-        let _ = writeln!(
-            out,
-            "<g><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"#ffffff\" \
-             fill-opacity=\"0.9\" stroke=\"#bbbbbb\" stroke-width=\"0.8\"/>",
-            num(r.x0),
-            num(r.y0),
-            num(self.w),
-            num(self.h)
-        );
-        for (row, name) in self.names.iter().enumerate() {
-            let cy = r.y0 + PAD + ROW * (row as f64 + 0.5);
-            let x0 = r.x0 + PAD;
-            if let Some(t) = self.rows.get(row).and_then(|&i| traces.get(i)) {
-                let color = escape_xml(&t.color);
-                if t.line {
-                    let d = format!("M{} {}H{}", num(x0), num(cy), num(x0 + SAMPLE));
-                    let width = if t.reference { 1.3 } else { 1.8 };
-                    svg::path(out, &d, &color, width, t.dashed.then_some(DASH));
+    /// Attaches the entries to `ctx` and draws plotters' series labels at `pos`.
+    pub fn draw<'a, DB: DrawingBackend + 'a, X, Y>(
+        &self,
+        ctx: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+        traces: &[Trace],
+        pos: SeriesLabelPosition,
+    ) -> Drawn<DB>
+    where
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        for (index, name) in &self.rows {
+            let anno = ctx.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
+            anno.label(name.as_str());
+            let Some(t) = index.and_then(|i| traces.get(i)) else {
+                continue;
+            };
+            let color = t.color;
+            let style = ShapeStyle::from(color).stroke_width(if t.reference { 1 } else { 2 });
+            let at = EmptyElement::at;
+            match (t.line, t.dashed, t.marker) {
+                (false, _, m) => anno.legend(move |p| at(p) + sample_marker(m.unwrap_or(0), color)),
+                (true, false, None) => anno.legend(move |p| at(p) + sample_solid(style)),
+                (true, false, Some(k)) => {
+                    anno.legend(move |p| at(p) + sample_solid(style) + sample_marker(k, color))
                 }
-                if let Some(shape) = t.marker {
-                    let mut body = String::new();
-                    svg::marker(&mut body, shape, x0 + SAMPLE / 2.0, cy, MARKER_R);
-                    svg::marker_group(out, &color, &body);
-                }
-            }
-            svg::text(out, x0 + SAMPLE + GAP, cy, FS_LEGEND, "start", "", name);
+                (true, true, None) => anno.legend(move |p| at(p) + sample_dashed(style, DASH)),
+                (true, true, Some(k)) => anno
+                    .legend(move |p| at(p) + sample_dashed(style, DASH) + sample_marker(k, color)),
+            };
         }
-        out.push_str("</g>\n");
+        ctx.configure_series_labels()
+            .position(pos)
+            .margin(MARGIN as u32)
+            .legend_area_size(SAMPLE as u32)
+            .label_font(font(FS_TICK).color(&INK))
+            .background_style(WHITE.mix(0.9))
+            .border_style(RGBColor(0xbb, 0xbb, 0xbb))
+            .draw()
     }
 }
 
-/// Number of data features (segments, markers, error bars) touching `r`.
-fn data_hits(traces: &[Trace], m: &Mapper, r: &Rect) -> usize {
+/// Number of data features (segments, markers, error bars) inside the box
+/// `bx` x `by` (transformed coordinates).
+fn data_hits(traces: &[Trace], bx: &Axis, by: &Axis) -> usize {
     let mut hits = 0;
     for t in traces {
         for run in &t.runs {
-            let pts: Vec<(f64, f64)> = run.iter().map(|&p| m.pt(p)).collect();
             if t.line {
-                hits += pts
+                hits += run
                     .windows(2)
-                    .filter(|s| r.hits_segment(s[0], s[1]))
+                    .filter(|s| data::clip(bx, by, s[0], s[1]).is_some())
                     .count();
             }
-            if t.marker.is_some() || (t.line && pts.len() == 1) {
-                hits += pts.iter().filter(|&&p| r.contains(p, MARKER_R)).count();
+            if t.marker.is_some() || (t.line && run.len() == 1) {
+                hits += run.iter().filter(|&&p| data::visible(bx, by, p)).count();
             }
         }
-        for e in &t.errs {
-            let (x, lo, hi) = m.err_ends(e);
-            hits += usize::from(r.hits_segment((x, lo.unwrap_or(m.plot.y1)), (x, hi)));
+        for &(x, lo, _, hi) in &t.errs {
+            let lo = lo.unwrap_or(by.lo.min(hi));
+            hits += usize::from(data::clip(bx, by, (x, lo), (x, hi)).is_some());
         }
     }
     hits

@@ -1,16 +1,20 @@
-//! Small, dependency-free SVG chart writer.
+//! SVG charts drawn with the `plotters` crate (SVG backend, no fonts needed:
+//! text is written as `<text>` elements for the viewer to render).
 //!
 //! Used by the `magsep chart ...` commands to draw accuracy-vs-cost and
 //! physics curves. A [`Chart`] is one plot panel (title, axis labels, linear or
 //! logarithmic axes, data [`Series`] and reference [`Line`]s, a legend); a
 //! [`Figure`] arranges several charts in a grid. Both render to a standalone
-//! SVG document with `to_svg`, which [`write_svg`] saves to disk.
+//! SVG document with `to_svg`, which [`write_svg`] saves to disk. Log axes
+//! use plotters' `.log_scale()`, error bars its `ErrorBar`, legends its
+//! series labels; heatmaps ([`Heatmap`]) are drawn as plotters rectangles.
 //!
 //! Rendering never panics: non-finite points are skipped (breaking the line),
 //! non-positive values are skipped on logarithmic axes (an axis falls back to
 //! linear when no positive value is left), and empty or constant data get a
 //! sensible default range. Output is deterministic: the same input always
-//! produces the same bytes.
+//! produces the same bytes. Pixel positions are whole pixels (plotters'
+//! backend coordinates are integers).
 //!
 //! ```
 //! use magsep::chart::{Chart, Figure, Line, Series, Style};
@@ -36,20 +40,47 @@
 
 #![warn(missing_docs)]
 
+mod axis;
 mod data;
 mod heatmap;
 mod legend;
 mod render;
-mod svg;
-mod ticks;
+mod style;
 
 #[cfg(test)]
 mod tests;
 
 use std::path::Path;
 
+use plotters::coord::Shift;
+use plotters::prelude::{DrawingArea, IntoDrawingArea, SVGBackend, WHITE};
+use plotters::style::Color;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
 pub use heatmap::{ColourScale, Heatmap};
-pub use svg::escape_xml;
+
+/// Clamps a requested image size (px) to something drawable.
+fn sanitize_size(v: f64, default: f64) -> u32 {
+    let v = if v.is_finite() && v > 0.0 {
+        v.clamp(60.0, 20_000.0)
+    } else {
+        default
+    };
+    v.round() as u32
+}
+
+/// Runs `draw` on a white `w` x `h` px SVG canvas and returns the document.
+/// A drawing error leaves the drawing incomplete but never panics.
+fn render_svg(w: u32, h: u32, draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>)) -> String {
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (w, h)).into_drawing_area();
+        let _ = root.fill(&WHITE.to_rgba());
+        draw(&root);
+        let _ = root.present();
+    }
+    out
+}
 
 /// Default colour palette (Okabe-Ito, colour-blind friendly), in the order
 /// series are coloured. Yellow is last because it is hard to see on white.
@@ -330,13 +361,11 @@ impl Chart {
     /// pixels (non-finite or tiny sizes are clamped to something drawable).
     #[must_use]
     pub fn to_svg(&self, width: f64, height: f64) -> String {
-        let w = svg::sanitize_size(width, 640.0);
-        let h = svg::sanitize_size(height, 420.0);
-        let mut out = String::new();
-        svg::open_document(&mut out, w, h);
-        render::render_chart(self, w, h, "c0", &mut out);
-        out.push_str("</svg>\n");
-        out
+        let w = sanitize_size(width, 640.0);
+        let h = sanitize_size(height, 420.0);
+        render_svg(w, h, |root| {
+            let _ = render::draw_chart(self, root);
+        })
     }
 }
 
@@ -374,45 +403,42 @@ impl Figure {
     /// SVG document.
     #[must_use]
     pub fn to_svg(&self, panel_width: f64, panel_height: f64) -> String {
-        let pw = svg::sanitize_size(panel_width, 480.0);
-        let ph = svg::sanitize_size(panel_height, 360.0);
+        let pw = sanitize_size(panel_width, 480.0);
+        let ph = sanitize_size(panel_height, 360.0);
         let n = self.panels.len();
         let cols = self.columns.clamp(1, n.max(1));
-        let rows = n.div_ceil(cols);
-        let title_h = if self.title.trim().is_empty() {
-            0.0
-        } else {
-            34.0
-        };
-        let w = pw * cols as f64;
-        let h = (title_h + ph * rows as f64).max(title_h.max(20.0));
-        let mut out = String::new();
-        svg::open_document(&mut out, w, h);
-        if title_h > 0.0 {
-            let text = svg::truncate_to_width(&self.title, w - 20.0, render::FS_FIGURE_TITLE);
-            svg::text(
-                &mut out,
-                w / 2.0,
-                22.0,
-                render::FS_FIGURE_TITLE,
-                "middle",
-                " font-weight=\"bold\"",
-                &text,
-            );
+        let rows = n.div_ceil(cols).max(1);
+        let title_h = if self.title.trim().is_empty() { 0 } else { 34 };
+        let w = pw.saturating_mul(cols as u32);
+        let h = title_h + ph.saturating_mul(rows as u32);
+        render_svg(w, h, |root| {
+            let _ = self.draw(root, title_h, (rows, cols));
+        })
+    }
+
+    /// Draws the title into the top `title_h` px and the panels in a
+    /// `rows` x `cols` grid below.
+    fn draw<DB: plotters::prelude::DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        title_h: u32,
+        grid: (usize, usize),
+    ) -> render::Drawn<DB> {
+        let (title_area, panels) = root.split_vertically(title_h);
+        if title_h > 0 {
+            let w = f64::from(root.dim_in_pixel().0);
+            let text = style::fit(&self.title, w - 20.0, style::FS_FIGURE_TITLE);
+            let anchor = Pos::new(HPos::Center, VPos::Center);
+            let font = style::bold(style::FS_FIGURE_TITLE)
+                .color(&style::INK)
+                .pos(anchor);
+            let at = ((w / 2.0) as i32, (title_h / 2) as i32);
+            title_area.draw(&plotters::element::Text::new(text, at, font))?;
         }
-        for (i, panel) in self.panels.iter().enumerate() {
-            let x = pw * (i % cols) as f64;
-            let y = title_h + ph * (i / cols) as f64;
-            out.push_str(&format!(
-                "<g transform=\"translate({} {})\">\n",
-                svg::num(x),
-                svg::num(y)
-            ));
-            render::render_chart(panel, pw, ph, &format!("p{i}"), &mut out);
-            out.push_str("</g>\n");
+        for (panel, area) in self.panels.iter().zip(panels.split_evenly(grid)) {
+            render::draw_chart(panel, &area)?;
         }
-        out.push_str("</svg>\n");
-        out
+        Ok(())
     }
 }
 

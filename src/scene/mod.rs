@@ -1,5 +1,5 @@
 //! Scenes: TOML files in SI units, parsed, validated (every error with its key path) and
-//! spawned (house plan, section 4).
+//! spawned (docs/architecture.md §4, scenes).
 //!
 //! ```
 //! use magsep::scene::parse_scene;

@@ -208,7 +208,7 @@ saturation_magnetisation = 985e3
     assert!(scene.is_field_only() && scene.fibres.len() == 1);
     let (sources, b, tol) = scene.field_sources();
     assert_eq!((b, tol), (glam::DVec3::X, magsep_systems::field::EXACT));
-    // Stoner-Wohlfarth: L/D = 20 at α = 45° gives θ ≈ 30.3° from the axis (spec 2.6)
+    // Stoner-Wohlfarth: L/D = 20 at α = 45° gives θ ≈ 30.3° from the axis (D-000-4 in docs/references.md)
     let m = sources[0].magnetisation;
     let theta = m
         .angle_between(glam::DVec3::new(1.0, 0.0, 1.0))

@@ -68,7 +68,7 @@ fn plan(quick: bool) -> Plan {
         )),
         aspect_angles: vec![0.0, 45.0, 90.0],
         aspect: Reduction::free_draining(1e-3, 3.0, 2, 50, 50),
-        // 2 s, longer than the thesis's 1 s: without HI the cloud needs ~1 s (spec §2.9);
+        // 2 s, longer than the thesis's 1 s: without HI the cloud needs ~1 s (D-000-11 in docs/references.md);
         // 100 particles: N = 500 with dipoles and Mie contacts did not finish 2 s within
         // 20 min here (captured particles pile up at the rim and the stepper bisects deeply)
         concentrated: Reduction::free_draining(2e-4, 2.0, 1, 100, 50),

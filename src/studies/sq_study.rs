@@ -482,7 +482,7 @@ pub fn render_sq_study_charts(r: &StudyResult) -> (String, String) {
         "supercuboids a = (0.5, 0.35, 0.7)",
         pct,
     ))
-    .line(Line::new("spec limit 0.1 %", [(2.0, 0.1), (10.0, 0.1)]).dashed(true))
+    .line(Line::new("target V-PK-5: 0.1 %", [(2.0, 0.1), (10.0, 0.1)]).dashed(true))
     .y_range(0.0, f64::NAN);
     let mut cost = Chart::new("Cost of one contact call (release, one thread)")
         .x_label("shape exponent g [-]")

@@ -1,7 +1,7 @@
 //! # magsep-systems
 //!
 //! Pure kernels (plain functions on `f64`/`DVec3`, no `World`) and the thin ECS systems that
-//! call them, plus the schedule labels and sets (house plan, sections 1-2).
+//! call them, plus the schedule labels and sets (docs/architecture.md §1-2).
 //!
 //! * [`sets`]: [`sets::SimSchedule`], the chained [`sets::SimSystems`] and [`sets::ForceSystems`].
 //! * [`forces`]: fixed-order accumulation of per-contribution force components.

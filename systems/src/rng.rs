@@ -1,4 +1,4 @@
-//! Per-particle random streams derived from (seed, ParticleId) (house plan, section 3).
+//! Per-particle random streams derived from (seed, ParticleId) (docs/architecture.md §3, determinism).
 //!
 //! The 256-bit xoshiro256++ state is filled from SplitMix64 seeded with a mix of the run seed
 //! and the particle id (the seeding the xoshiro authors recommend), so stream k does not depend

@@ -1,4 +1,4 @@
-//! The simulation schedule and its chained sets (house plan, section 2).
+//! The simulation schedule and its chained sets (docs/architecture.md §2, schedule).
 //!
 //! One schedule, [`SimSchedule`], runs once per step. Its top-level sets run in this order:
 //! `Prepare -> Forces -> Accumulate -> Mobility -> Integrate -> Constraints -> Finalize ->

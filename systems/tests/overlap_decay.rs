@@ -1,4 +1,4 @@
-//! The thesis's overlap-decay experiment (thesis 000, Fig. 3.4, L720-729; spec packing.md 5.4):
+//! The thesis's overlap-decay experiment ([T000 §3.6, Fig. 3.4]; target V-PK-9):
 //! three spherocylinders of aspect ratio 5, each slightly overlapping the other two, relaxed by
 //! (a) the revised rule, (b) the original rule, (c) revised with a random rotation direction,
 //! (d) revised with random translation and rotation directions. One step moves each overlapping
@@ -81,7 +81,7 @@ fn configuration(seed: u64) -> PackingState {
 
 /// Overlap tolerance of the experiment / D. Without a tolerance the revised rule's delta_min
 /// factor (eq. 3.9) freezes a particle whose smallest contact sits at round-off overlap
-/// (1e-15), as every MCM run has one (the thesis uses 1e-4 in packings, L386).
+/// (1e-15), as every MCM run has one (the thesis uses 1e-4 in packings, [T000 §2.2.6]).
 const TOL: f64 = 1e-9;
 
 struct Decay {

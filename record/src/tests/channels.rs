@@ -256,14 +256,20 @@ fn record_metadata_plugins_and_extra_round_trip() {
 }
 
 /// Writes a recording with plugin channels (`/energy`: protobuf `magsep.test.Energy`; `/notes`:
-/// JSON) and a plugin metadata record for the Python check when `MAGSEP_WRITE_CUSTOM_SAMPLE`
-/// names a `.mcap` path.
+/// JSON) and a plugin metadata record, and checks it reads back: to the `.mcap` path in
+/// `MAGSEP_WRITE_CUSTOM_SAMPLE` (for the Python check), else to a temporary file.
 #[test]
 fn record_write_custom_channel_sample_for_python_check() {
-    let Ok(target) = std::env::var("MAGSEP_WRITE_CUSTOM_SAMPLE") else {
-        return;
-    };
-    assert!(target.ends_with(".mcap"), "{target}: expected a .mcap path");
-    write_with_channels(std::path::Path::new(&target), true);
-    eprintln!("wrote {target}");
+    let target = std::env::var("MAGSEP_WRITE_CUSTOM_SAMPLE")
+        .ok()
+        .filter(|t| t.ends_with(".mcap"))
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::env::temp_dir().join(format!("magsep-custom-{}.mcap", std::process::id()))
+        });
+    write_with_channels(&target, true);
+    let rec = crate::read_recording(&target).unwrap();
+    assert!(rec.truncated.is_none());
+    let topics: Vec<&str> = rec.channels.iter().map(|c| c.topic.as_str()).collect();
+    assert!(topics.contains(&"/energy") && topics.contains(&"/notes"), "{topics:?}");
 }

@@ -467,19 +467,18 @@ fn record_writer_rejects_inconsistent_frames() {
     assert_frames_bitwise_eq(&rec.frames, &[frame]);
 }
 
-/// Writes a sample recording (spheres and capsules in a box, with colours) for the Python check
-/// when `MAGSEP_WRITE_SAMPLE` is set: to its value if that is a path ending in `.mcap`, else to
-/// `target/record_sample.mcap`.
+/// Writes a sample recording (spheres and capsules in a box, with colours) and checks that it
+/// reads back: to the `.mcap` path in `MAGSEP_WRITE_SAMPLE` (for the Python check), else to a
+/// temporary file.
 #[test]
 fn record_write_sample_for_python_check() {
-    let Ok(target) = std::env::var("MAGSEP_WRITE_SAMPLE") else {
-        return;
-    };
-    let path = if target.ends_with(".mcap") {
-        PathBuf::from(target)
-    } else {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/record_sample.mcap")
-    };
+    let path = std::env::var("MAGSEP_WRITE_SAMPLE")
+        .ok()
+        .filter(|t| t.ends_with(".mcap"))
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            std::env::temp_dir().join(format!("magsep-sample-{}.mcap", std::process::id()))
+        });
     let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
     let edges = DVec3::new(4e-6, 4e-6, 8e-6);
     for step in 0..20u64 {
@@ -516,7 +515,9 @@ fn record_write_sample_for_python_check() {
     }
     w.write_summary(SUMMARY).unwrap();
     w.finish().unwrap();
-    eprintln!("wrote {}", path.display());
+    let rec = read_recording(&path).unwrap();
+    assert_eq!(rec.frames.len(), 20);
+    assert!(rec.truncated.is_none());
 }
 
 #[test]

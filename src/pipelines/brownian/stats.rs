@@ -1,22 +1,16 @@
 //! Ensemble statistics: means with 95 % confidence intervals.
 
-/// Two-sided 97.5 % quantiles of Student's t for 1..=30 degrees of freedom.
-const T975: [f64; 30] = [
-    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
-    2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
-    2.052, 2.048, 2.045, 2.042,
-];
+use magsep_systems::analysis::confinement::student_t_95;
 
-/// t quantile for a 95 % two-sided interval with `df` degrees of freedom (normal beyond 30,
-/// within 2 % of the exact value).
+/// t quantile for a 95 % two-sided interval with `df` degrees of freedom (infinite for 0),
+/// exact (`statrs` inverse CDF, see [`student_t_95`]).
+///
+/// ```
+/// use magsep::brownian::stats::t_quantile_95;
+/// assert!((t_quantile_95(2) - 4.302_652_729_749_46).abs() < 1e-8);
+/// ```
 pub fn t_quantile_95(df: usize) -> f64 {
-    match df {
-        0 => f64::INFINITY,
-        1..=30 => T975[df - 1],
-        d if d <= 60 => 2.042 - (2.042 - 2.000) * (d - 30) as f64 / 30.0,
-        d if d <= 120 => 2.000 - (2.000 - 1.980) * (d - 60) as f64 / 60.0,
-        _ => 1.96,
-    }
+    student_t_95(df)
 }
 
 /// A mean with its 95 % interval.
@@ -37,7 +31,7 @@ pub struct Estimate {
 /// use magsep::brownian::stats::mean_interval;
 /// let e = mean_interval(&[0.5, 0.7, 0.6]);
 /// assert!((e.mean - 0.6).abs() < 1e-12);
-/// assert!((e.hi - e.mean - 4.303 * 0.1 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((e.hi - e.mean - 4.302_652_729_749_46 * 0.1 / 3f64.sqrt()).abs() < 1e-9);
 /// ```
 pub fn mean_interval(values: &[f64]) -> Estimate {
     let n = values.len();

@@ -12,7 +12,7 @@ pub const DETAIL_LIMIT: usize = 20;
 
 /// The explicit scheme's history amplification factor
 /// `r = 18 √(ρ_f μ Δt/π)/((ρ_p + ½ρ_f) d)` and the drag limit `2 τ_eff` [s] of a sphere
-/// (spec §2.3): the forward-Euler step diverges once `0.76 r ≳ 1 − Δt/(2τ_eff)`.
+/// (D-002-2, docs/references.md): the forward-Euler step diverges once `0.76 r ≳ 1 − Δt/(2τ_eff)`.
 pub fn explicit_stability(cfg: &ParticleFluidConfig, diameter: f64, density: f64) -> (f64, f64) {
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
     let r = 18.0 * (rho * mu * cfg.dt / std::f64::consts::PI).sqrt()

@@ -30,7 +30,7 @@ use crate::studies::bench::{BenchError, emit};
 
 /// Time step of the history timings (the thesis's many-particle runs) [s].
 pub(crate) const BENCH_DT: f64 = 0.9e-3;
-/// Window of the history timings: 0.35 s at 0.9 ms = 389 steps (thesis L883).
+/// Window of the history timings: 0.35 s at 0.9 ms = 389 steps ([T002 §2.5.3]).
 pub(crate) const BENCH_WINDOW: HistoryKernel = HistoryKernel::Window {
     steps: 389,
     tail: true,

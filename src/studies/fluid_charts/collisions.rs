@@ -26,7 +26,7 @@ use magsep_components::prelude::*;
 const SCENE: &str = include_str!("../../../scenes/binary_collision.toml");
 /// L of the rig [m] (y = z − L).
 const HALF_HEIGHT: f64 = 0.075;
-/// The thesis's delays at I = 0.02 (experiment, L845): sinking PVC-U, rising POM.
+/// The thesis's delays at I = 0.02 (experiment, [T002 §2.5.2.2, Fig. 2.12]): sinking PVC-U, rising POM.
 const THESIS_DELAYS: (f64, f64) = (0.15, 0.45);
 
 /// One run: the sampled heights y/L of every particle and their levitation times [s].

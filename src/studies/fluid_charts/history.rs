@@ -1,7 +1,7 @@
 //! `magsep chart history`: accuracy, cost and stability of the Basset-history method family
 //! (full-memory product integration; window + ten-exponential tail of van Hinsberg et al.;
-//! truncated window) and of the two velocity updates (spec `density-separation-spheres.md`
-//! §2.3-2.4):
+//! truncated window) and of the two velocity updates ([T002 §2.3.2.1]; D-002-2, D-002-3 in
+//! docs/references.md):
 //!
 //! * `history_accuracy_cost.svg` (a): a 100 µm PVC-U sphere (ρ_p = 1434 kg/m³) released from
 //!   rest in quiescent MnCl₂ (no magnet, Stokes drag): the maximum velocity error against the
@@ -324,7 +324,7 @@ fn window_chart(out: &Path, quick: bool) -> Result<(String, Value), BenchError> 
     );
     tl_panel = tl_panel.line(
         Line::new(
-            "spec 7.5: 1 %",
+            "V-DS-5: 1 %",
             [(windows[0], 0.01), (windows[windows.len() - 1], 0.01)],
         )
         .color("#999999"),

@@ -4,7 +4,7 @@
 //! **Stability.** Spheres of the table 2.1 rig (d = 0.05-2 mm, PVC-U) released from rest at
 //! y = −0.5 L with every term on (history: 0.05 s window + tail), run for max(1 s, 100 Δt).
 //! A run diverges when |v| exceeds 100 × the Stokes speed of the largest net static force
-//! (at the magnet face or the top) or turns non-finite. Theory (spec §2.3), with
+//! (at the magnet face or the top) or turns non-finite. Theory (D-002-2, docs/references.md), with
 //! `τ_eff = (ρ_p + ½ρ_f) d²/(18μ)` and `r = 18√(ρ_f μ Δt/π)/((ρ_p + ½ρ_f) d)`: explicit drag
 //! is stable for Δt < 2τ_eff; the explicit history adds the bound `0.76 r < 1 − Δt/(2τ_eff)`.
 

@@ -1,12 +1,12 @@
 //! `magsep chart levitation`: the single-particle results of thesis 002, ch. 2 (Tajfirooz 2021;
-//! spec `density-separation-spheres.md` §1.5, §2.2-2.4, §4 V1-V11, §7 items 3-5), on the
+//! docs/references.md: E-002-4, E-002-5, E-002-7, D-002-2, D-002-5, V-DS-R1 to V-DS-R11, V-DS-3 to V-DS-5), on the
 //! table 2.1 rig (bottom magnet, saturated MnCl₂, PVC-U ρ_p = 1434 kg/m³), integrated with
 //! [`SphereInLiquid`] (linearly implicit Euler, Δt = 1 ms, Schiller-Naumann drag):
 //!
 //! * `levitation_trajectories.svg` (a): y(t) of 1, 2, 4, 6 mm spheres released from rest at
 //!   y₀ = −0.9 L, without history (fig. 2.5a) and with history (figs. 2.7/2.8), y_e marked;
 //! * `levitation_time.svg` (b): t_l against d (fig. 2.5b), tolerance 0.5 mm, with and without
-//!   history, the critical diameters and the spec's [CHECK] values;
+//!   history, the critical diameters and the reference values D-002-5;
 //! * `critical_diameter.svg` (c): the linearised eigenvalues against d and node/spiral from
 //!   direct integration (see [`modes`]);
 //! * `sink_rise.svg` (d): fig. 2.10, 3 and 5 mm sinking from +0.9 L and rising from −0.9 L;
@@ -41,7 +41,7 @@ pub(crate) const DT: f64 = 1e-3;
 /// History window of the "with history" runs [s] (fig. 2.10).
 pub(crate) const WINDOW: f64 = 0.2;
 
-/// The spec's [CHECK] levitation times without history (d [mm], t_l [s]), §4.
+/// Reference levitation times without history (d [mm], t_l [s]), D-002-5 (docs/references.md).
 const CHECK_NO_HISTORY: [(f64, f64); 7] = [
     (1.0, 23.1),
     (2.0, 6.44),
@@ -51,7 +51,7 @@ const CHECK_NO_HISTORY: [(f64, f64); 7] = [
     (5.0, 2.15),
     (6.0, 2.98),
 ];
-/// The spec's [CHECK] levitation times with history (d [mm], t_l [s]), §4.
+/// Reference levitation times with history (d [mm], t_l [s]), D-002-5 (docs/references.md).
 const CHECK_HISTORY: [(f64, f64); 3] = [(2.0, 11.0), (4.0, 5.3), (6.0, 3.5)];
 
 /// Sizes of the chart (quick or full).
@@ -302,7 +302,7 @@ fn sweep_chart(
         .collect();
     let times = times.into_iter().collect::<Result<Vec<_>, _>>()?;
     let (none, hist) = times.split_at(ds.len());
-    // the [CHECK] points, ours with the implicit step and with explicit Euler (as the spec)
+    // the D-002-5 points, ours with the implicit step and with explicit Euler (as D-002-5)
     let check: Vec<Result<Value, BenchError>> = CHECK_NO_HISTORY
         .par_iter()
         .filter(|(d, _)| !sizes.quick || *d == 2.0 || *d == 4.0)
@@ -342,11 +342,11 @@ fn sweep_chart(
     .series(Series::new("no history", pts(none)).style(Style::Line))
     .series(Series::new("history (0.2 s window + tail)", pts(hist)).style(Style::Line))
     .series(
-        Series::new("spec [CHECK], no history", CHECK_NO_HISTORY.iter().copied())
+        Series::new("D-002-5, no history", CHECK_NO_HISTORY.iter().copied())
             .style(Style::Markers),
     )
     .series(
-        Series::new("spec [CHECK], history", CHECK_HISTORY.iter().copied()).style(Style::Markers),
+        Series::new("D-002-5, history", CHECK_HISTORY.iter().copied()).style(Style::Markers),
     )
     .line(
         vline(
@@ -367,7 +367,7 @@ fn sweep_chart(
         "all_settled": times.iter().all(|r| r.1),
         "minimum_no_history": refine_minimum(ds, none, false, sizes)?,
         "minimum_history": refine_minimum(ds, hist, true, sizes)?,
-        "spec_minimum": "near 4-4.5 mm (V4, spec 7.4)",
+        "spec_minimum": "near 4-4.5 mm (V-DS-R4, V-DS-4)",
         "check": check,
     });
     Ok((path, summary))

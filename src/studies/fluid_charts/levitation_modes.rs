@@ -163,7 +163,7 @@ pub(super) fn critical_chart(
             "largest_overshoot_over_delta_below_switch": largest_node,
         }));
     }
-    // the thesis's V3 from y0 = -0.9 L (Schiller-Naumann): crossings of y_e
+    // the thesis's node/spiral result (V-DS-R3, [T002 §2.5.1.1]) from y0 = -0.9 L (Schiller-Naumann): crossings of y_e
     let v3_ds: &[f64] = if quick {
         &[2e-3, 6e-3]
     } else {

@@ -5,7 +5,7 @@
 //!
 //! Full mode runs the scenes as shipped (table 2.4 particle counts, 5 s); `--quick` shrinks the
 //! channel's periods by 3 (the particle count by 9 at the same volume fraction; case 2 by 6)
-//! and the duration to 2.5 s. The thesis's numbers are statistical (spec 7: compare ensembles
+//! and the duration to 2.5 s. The thesis's numbers are statistical (target V-DS-7: compare ensembles
 //! of seeds), so full mode runs seeds 1-3 of every case but case 2 (seed 1: 70 685 particles);
 //! the charts show the seed-averaged e_m(t) and the summary lists every seed's time to 0.02 with
 //! their mean and standard deviation. Charts:

@@ -7,7 +7,7 @@
 //!
 //! Every point is the mean of independent runs (seeds 1..=runs) with a Student-t 95 % interval.
 //! Periodic reference runs of the same shapes give phi_periodic and <C>_periodic for the
-//! rescaled measures phi* and <C>* (spec packing.md 9.8). Runs go in parallel over rayon;
+//! rescaled measures phi* and <C>* ([T000 §2.4]). Runs go in parallel over rayon;
 //! each run is single-threaded and deterministic.
 
 mod sweeps;
@@ -133,7 +133,7 @@ pub const MAX_PARTICLES: usize = 800;
 
 /// The particle count for `container`: at least `n`, and enough that the compressed (periodic)
 /// length ends near three particle lengths at phi ~ 0.55 (the thesis raised N for the same
-/// reason, F20: a compressed axis shorter than a particle makes a quasi-2-D, artificially
+/// reason, [T000 §2.2.6]: a compressed axis shorter than a particle makes a quasi-2-D, artificially
 /// jammed layer), at most [`MAX_PARTICLES`].
 pub fn particles_for(container: &ContainerSpec, shape: Shape, n: usize) -> usize {
     let area = match *container {

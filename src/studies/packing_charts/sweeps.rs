@@ -28,7 +28,7 @@ fn sizes(quick: bool, n_full: usize, runs_full: u64) -> (usize, u64) {
     if quick { (60, 1) } else { (n_full, runs_full) }
 }
 
-/// Cylinder confinement (thesis figs. 2.10-2.11; spec 10.2): phi*, <C>* against D_cyl,
+/// Cylinder confinement (thesis figs. 2.10-2.11; target V-PK-16): phi*, <C>* against D_cyl,
 /// S against D_cyl / aspect, and the 1/D_cyl extrapolation of phi.
 pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;
@@ -169,7 +169,7 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     Ok(())
 }
 
-/// Wedge confinement (thesis figs. 2.12-2.16; spec 10.3): phi*, <C>* against l_w / l_w,min and
+/// Wedge confinement (thesis figs. 2.12-2.16; target V-PK-17): phi*, <C>* against l_w / l_w,min and
 /// the wall-aligned fraction against the aspect ratio.
 pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;
@@ -329,7 +329,7 @@ fn orientation_map(
     ))
 }
 
-/// Superballs (thesis figs. 4.5-4.6; spec 10.4): phi, <C>, S_4 and the nematic order against
+/// Superballs (thesis figs. 4.5-4.6; target V-PK-18): phi, <C>, S_4 and the nematic order against
 /// the exponent, with the thesis's values.
 pub fn chart_superballs(out: &Path, quick: bool) -> Result<(), BenchError> {
     out_dir(out)?;

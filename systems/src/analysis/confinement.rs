@@ -1,8 +1,8 @@
 //! Confinement measures: rescaled packing fraction and contact number, the bulk
-//! extrapolation in 1/D_cyl, and Student-t confidence intervals (thesis 000, L407, L420-439,
-//! L456, L499; spec packing.md 9.8, 9.9, 9.11).
+//! extrapolation in 1/D_cyl, and Student-t confidence intervals ([T000 §2.3-2.5],
+//! see docs/references.md).
 //!
-//! Rescalings (L420, L435) map the confined value onto [0, 1] between a reference low value
+//! Rescalings ([T000 §2.4]) map the confined value onto [0, 1] between a reference low value
 //! and the periodic (bulk) value:
 //!
 //! * cylinder: `phi* = phi / phi_periodic`;
@@ -11,14 +11,14 @@
 //! * both: `<C>* = (<C> - 2) / (<C>_periodic - 2)` (the thesis's "\[2, `<C>_periodic`\] ->
 //!   \[0, 1\]"; it can exceed 1).
 //!
-//! Bulk extrapolation (Scott & Kilgour, L439): ordinary least squares phi = a + b / D_cyl;
+//! Bulk extrapolation (Scott & Kilgour \[ScottKilgour1969\], [T000 §2.5]): ordinary least squares phi = a + b / D_cyl;
 //! the intercept a is the extrapolation to 1/D_cyl -> 0, with standard error
 //! s sqrt(1/n + xbar^2 / Sxx), s^2 = RSS / (n - 2), Sxx = sum (x - xbar)^2, x = 1/D_cyl.
 //!
-//! Confidence intervals (L407): xbar +- t_{0.975, n-1} s / sqrt(n) with the sample standard
+//! Confidence intervals ([T000 §2.3]): xbar +- t_{0.975, n-1} s / sqrt(n) with the sample standard
 //! deviation s. t is tabulated to 4 decimals for 1..=30 degrees of freedom; beyond, the
 //! Cornish-Fisher expansion t = z + g1/nu + g2/nu^2 + g3/nu^3 (z = 1.959964) is used, within
-//! 1e-4 of the exact quantile (the spec's 1.96 is its nu -> infinity limit; the expansion
+//! 1e-4 of the exact quantile (the normal quantile 1.96 is its nu -> infinity limit; the expansion
 //! removes the 4 % jump from 2.042 to 1.96 at nu = 31).
 
 /// Rescaled packing fraction in a cylinder, phi / phi_periodic.
@@ -166,7 +166,7 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> Result<LinearFit, FitError> {
 }
 
 /// Linear fit of phi against 1/D_cyl (`cylinder_diameters` in D); its `intercept` is the
-/// bulk packing fraction extrapolated to 1/D_cyl -> 0 (L439, L456).
+/// bulk packing fraction extrapolated to 1/D_cyl -> 0 ([T000 §2.5]).
 ///
 /// # Errors
 /// As [`fit_line`].
@@ -183,31 +183,21 @@ pub fn bulk_extrapolation(cylinder_diameters: &[f64], phi: &[f64]) -> Result<Lin
     fit_line(&x, phi)
 }
 
-/// Two-sided 95 % Student-t quantile t_{0.975, dof} (infinite for 0 degrees of freedom).
+/// Two-sided 95 % Student-t quantile t_{0.975, dof} (infinite for 0 degrees of freedom),
+/// exact to double precision through `statrs`' inverse CDF.
 ///
 /// ```
 /// use magsep_systems::analysis::confinement::student_t_95;
-/// assert_eq!(student_t_95(4), 2.7764);
+/// assert!((student_t_95(4) - 2.776_445_105_197_799).abs() < 1e-9);
 /// assert!((student_t_95(100_000) - 1.96).abs() < 1e-3);
 /// ```
 pub fn student_t_95(dof: usize) -> f64 {
-    const TABLE: [f64; 30] = [
-        12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622, 2.2281, 2.2010,
-        2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860, 2.0796, 2.0739,
-        2.0687, 2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423,
-    ];
-    match dof {
-        0 => f64::INFINITY,
-        1..=30 => TABLE[dof - 1],
-        _ => {
-            let z: f64 = 1.959_963_984_540_054;
-            let nu = dof as f64;
-            let (z3, z5, z7) = (z.powi(3), z.powi(5), z.powi(7));
-            let g1 = (z3 + z) / 4.0;
-            let g2 = (5.0 * z5 + 16.0 * z3 + 3.0 * z) / 96.0;
-            let g3 = (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / 384.0;
-            z + g1 / nu + g2 / (nu * nu) + g3 / (nu * nu * nu)
-        }
+    if dof == 0 {
+        return f64::INFINITY;
+    }
+    match statrs::distribution::StudentsT::new(0.0, 1.0, dof as f64) {
+        Ok(t) => statrs::distribution::ContinuousCDF::inverse_cdf(&t, 0.975),
+        Err(_) => f64::NAN,
     }
 }
 
@@ -230,7 +220,7 @@ pub struct MeanInterval {
 /// use magsep_systems::analysis::confinement::mean_interval_95;
 /// let m = mean_interval_95(&[0.60, 0.62, 0.64]).unwrap();
 /// assert!((m.mean - 0.62).abs() < 1e-15);
-/// assert!((m.half_width - 4.3027 * 0.02 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((m.half_width - 4.302_652_729_749_46 * 0.02 / 3f64.sqrt()).abs() < 1e-9);
 /// ```
 pub fn mean_interval_95(samples: &[f64]) -> Option<MeanInterval> {
     let n = samples.len();
@@ -278,6 +268,16 @@ mod tests {
         eprintln!("t quantiles: max |P - 0.95| = {max_err:.1e}");
         assert!(max_err < 1e-5, "{max_err}");
         assert!(student_t_95(0).is_infinite());
+        // Reference values t_{0.975, nu} (R: qt(0.975, nu)).
+        for (nu, t) in [
+            (1, 12.706_204_736_174_7),
+            (2, 4.302_652_729_749_46),
+            (10, 2.228_138_851_986_27),
+            (30, 2.042_272_456_301_24),
+            (120, 1.979_930_405_052_72),
+        ] {
+            assert!((student_t_95(nu) - t).abs() < 1e-8 * t, "nu = {nu}");
+        }
     }
 
     #[test]
@@ -339,7 +339,7 @@ mod tests {
         assert_eq!(rescaled_packing_fraction_wedge(0.3, 0.6, 0.3), 0.0);
         assert_eq!(rescaled_packing_fraction_wedge(0.6, 0.6, 0.3), 1.0);
         assert_eq!(rescaled_contact_number(6.0, 6.0), 1.0);
-        assert!(rescaled_contact_number(7.0, 6.0) > 1.0); // may exceed 1 (L425)
+        assert!(rescaled_contact_number(7.0, 6.0) > 1.0); // may exceed 1 ([T000 §2.4])
         let m = mean_interval_95(&[1.0, 1.0, 1.0, 1.0]).unwrap();
         assert_eq!((m.mean, m.half_width, m.n), (1.0, 0.0, 4));
         assert!(mean_interval_95(&[1.0]).is_none());

@@ -1,7 +1,7 @@
-//! Mean contact number <C> (thesis 000, L367, L614).
+//! Mean contact number <C> ([T000 §2.2.5, §3.3]).
 //!
 //! Two particles touch when their surface gap is below delta. The mean per-particle count is
-//! 2 (#touching pairs) / N (erratum E5: the text omits the factor 2). Because overlaps up to
+//! 2 (#touching pairs) / N (erratum E-000-5: the text omits the factor 2). Because overlaps up to
 //! the tolerance survive and round-off blurs exact touching, <C>(delta) is evaluated at 16
 //! log-spaced delta in [1e-8, 1e-5] D and a least-squares straight line in delta is
 //! extrapolated to delta = 0 (Wouterse et al. 2007, as in the thesis). Gaps may be negative

@@ -1,5 +1,5 @@
 //! Per-axis nematic order S_{2,j} and cubatic order S_4 of particles with three body axes
-//! (superballs; thesis 000, sec. 4.3, eqs. 4.16, 4.17, L946-954, after Batten et al.).
+//! (superballs; thesis 000, §4.5, eqs. 4.16, 4.17, after Batten et al. \[Batten2010\]).
 //!
 //! With u_ij = body axis j (x, y, z) of particle i in the lab frame:
 //!
@@ -15,7 +15,7 @@
 //! T(n) = (1/N) sum_{i,j} (u_ij . n)^4 = M[n, n, n, n], M = (1/N) sum u (x) u (x) u (x) u.
 //! A perfect cubic crystal gives T = 1 along a crystal axis (S_4 = 1); isotropic
 //! orientations give E T = 3/5 for every n (S_4 = 0 in expectation; a finite sample's
-//! maximum sits at a floor of about 0.04 for N = 750, spec 9.5).
+//! maximum sits at a floor of about 0.04 for N = 750, D-000-16).
 //!
 //! Maximisation (reconstruction: the thesis takes "a large number of random trial vectors"):
 //! M is accumulated once (O(N)); T is evaluated at 5000 deterministic trial directions on the

@@ -1,10 +1,12 @@
 //! Orientational order. Nematic order S (thesis 000, eq. 2.11): the largest eigenvalue of
 //! Q = (1/N) sum_i (3/2 u_i u_i^T - 1/2 I). 1 for perfect alignment, about 0.036 for 500
-//! random axes (finite-size floor, spec packing.md 9.3).
+//! random axes (finite-size floor, D-000-16).
 
 use glam::{DMat3, DVec3};
 
-/// Eigenvalues of a symmetric 3x3 matrix, ascending (cyclic Jacobi, to round-off).
+/// Eigenvalues of a symmetric 3x3 matrix, ascending (faer's self-adjoint eigensolver, to
+/// round-off; the lower triangle is read). NaN if an entry is not finite. Not a hot path (one
+/// call per packing), so no closed-form 3x3 kernel is kept.
 ///
 /// ```
 /// use glam::DMat3;
@@ -13,34 +15,19 @@ use glam::{DMat3, DVec3};
 /// assert_eq!(e, [1.0, 2.0, 3.0]);
 /// ```
 pub fn symmetric_eigenvalues(m: DMat3) -> [f64; 3] {
-    let mut a = m.to_cols_array_2d();
-    for _ in 0..50 {
-        let off = a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2);
-        if off < 1e-30 * (a[0][0].powi(2) + a[1][1].powi(2) + a[2][2].powi(2)).max(1e-300) {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q].abs() < 1e-300 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let t = if theta == 0.0 { 1.0 } else { t };
-            let c = 1.0 / (t * t + 1.0).sqrt();
-            let s = t * c;
-            for row in a.iter_mut() {
-                let (akp, akq) = (row[p], row[q]);
-                row[p] = c * akp - s * akq;
-                row[q] = s * akp + c * akq;
-            }
-            let (rp, rq) = (a[p], a[q]);
-            a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
-            a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
-        }
+    let a = m.to_cols_array_2d();
+    if a.iter().flatten().any(|v| !v.is_finite()) {
+        return [f64::NAN; 3];
     }
-    let mut e = [a[0][0], a[1][1], a[2][2]];
-    e.sort_by(f64::total_cmp);
-    e
+    let mat = faer::Mat::from_fn(3, 3, |r, c| a[c][r]);
+    match mat.self_adjoint_eigenvalues(faer::Side::Lower) {
+        Ok(ev) if ev.len() == 3 => {
+            let mut e = [ev[0], ev[1], ev[2]];
+            e.sort_by(f64::total_cmp);
+            e
+        }
+        _ => [f64::NAN; 3],
+    }
 }
 
 /// Nematic order parameter S of unit axes `axes` (0 for an empty set).
@@ -82,8 +69,25 @@ mod tests {
     }
 
     #[test]
+    fn eigenvalues_of_a_known_matrix() {
+        // [[2, 1, 0], [1, 2, 1], [0, 1, 2]]: 2 - sqrt 2, 2, 2 + sqrt 2.
+        let m = DMat3::from_cols_array(&[2.0, 1.0, 0.0, 1.0, 2.0, 1.0, 0.0, 1.0, 2.0]);
+        let e = symmetric_eigenvalues(m);
+        let r2 = 2f64.sqrt();
+        for (a, b) in e.iter().zip([2.0 - r2, 2.0, 2.0 + r2]) {
+            assert!((a - b).abs() < 1e-14, "{e:?}");
+        }
+        // Degenerate (isotropic) and non-finite input.
+        let iso = symmetric_eigenvalues(DMat3::IDENTITY * 0.5);
+        assert!(iso.iter().all(|v| (v - 0.5).abs() < 1e-15), "{iso:?}");
+        assert!(
+            symmetric_eigenvalues(DMat3::from_diagonal(DVec3::new(f64::NAN, 1.0, 2.0)))[0].is_nan()
+        );
+    }
+
+    #[test]
     fn random_axes_sit_at_the_finite_size_floor() {
-        // spec 9.3: <S> ~ 0.036 for N = 500 isotropic axes; check the mean over 40 sets
+        // D-000-16: <S> ~ 0.036 for N = 500 isotropic axes; check the mean over 40 sets
         let mut rng = particle_stream(5, 0);
         let mut mean = 0.0;
         for _ in 0..40 {

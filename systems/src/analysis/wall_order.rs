@@ -1,5 +1,5 @@
 //! Order at hard walls: the fraction of wall-aligned particles and orientation-density
-//! histograms (thesis 000, Figs. 2.6, 2.15, L372, L470-474, L488; spec packing.md 9.6, 9.7).
+//! histograms ([T000 §2.2.5, §2.5, Figs. 2.6, 2.15]).
 //!
 //! # f_align
 //!
@@ -12,8 +12,8 @@
 //! Three counts are returned. `pooled` counts (particle, wall) pairs over all walls: the
 //! thesis's measure, in which a particle near two planes (the wedge's corners) is counted
 //! twice but can be aligned with only one of them, so f_align is underestimated in small
-//! wedges (L470, failure F12). `per_wall` gives the same split by plane, which has no such
-//! cross-talk (the spec's remedy). `particles` counts each near-wall particle once, aligned
+//! wedges ([T000 §2.5], a limitation the thesis names). `per_wall` gives the same split by plane, which has no such
+//! cross-talk (the remedy the thesis suggests). `particles` counts each near-wall particle once, aligned
 //! if aligned with at least one wall it is near.
 //!
 //! # Orientation histograms
@@ -24,8 +24,8 @@
 //! between the projection and the x axis. The fold identifies phi, -phi, 180 - phi and
 //! 180 + phi (head-tail symmetry and the mirror y -> -y). In a wedge, particles aligned with
 //! the bottom sit at phi = 0, along the slope at phi = alpha (the thesis's 9 deg example,
-//! L474), in the back plane (yz) at phi = 90 deg, and along z at cos(theta) = 1 (all three
-//! planes contain z; the thesis assigns the back to cos(theta) = 1, spec 9.7 leaves this
+//! [T000 §2.5, Fig. 2.15]), in the back plane (yz) at phi = 90 deg, and along z at cos(theta) = 1 (all three
+//! planes contain z; the thesis assigns the back to cos(theta) = 1, erratum E-000-27 treats this as
 //! uncertain). An axis along z has phi = 0. Both upper limits are closed: cos(theta) = 1 and
 //! phi = 90 deg fall in the last bins. Isotropic axes have a uniform density in
 //! (cos(theta), phi), so [`OrientationHistogram::density`] is normalised to 1 for them.

@@ -1,14 +1,14 @@
 //! Contacts that must never be crossed: capture on a fibre along the swept segment of a step,
 //! and hard-core overlap removal between particles.
 //!
-//! **Capture** (thesis L1702: a particle that comes into contact with the cylinder is captured
+//! **Capture** ([T000 §6.3]: a particle that comes into contact with the cylinder is captured
 //! and fixed). A step moves a particle along the segment `x0 → x1`; the particle is captured at
 //! the first point of that segment whose distance to a fibre is at most its radius. The distance
 //! to a solid cylinder is 1-Lipschitz, so bisection with the bound
 //! `min_[s0,s1] d ≥ (d(s0) + d(s1) − |x(s1) − x(s0)|) / 2` finds that point without sampling
-//! gaps (spec §4 item 15: at the thesis's steps a 25 nm particle moves more than its radius).
+//! gaps (D-000-10 in docs/references.md: at the thesis's steps a 25 nm particle moves more than its radius).
 //!
-//! **Hard cores** (an overlap-safe alternative to the stiff Mie potential, spec §4 item 14,
+//! **Hard cores** (an overlap-safe alternative to the stiff Mie potential, D-000-10,
 //! in the spirit of Heyes and Melrose, J. Non-Newtonian Fluid Mech. 46, 1 (1993)): after a move,
 //! every overlapping pair is pushed apart along its line of centres to contact, shared equally
 //! when both move and taken wholly by the mobile one otherwise; Gauss-Seidel sweeps in a fixed

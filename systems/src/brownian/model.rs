@@ -4,7 +4,7 @@
 //!
 //! * Moments are parallel to the local flux density B = B_ext + Σ fibres (ch. 5 fields), with
 //!   magnitude from [`MomentModel`] (saturated, or Langevin eq. 6.22). Mutual induction
-//!   between particles is neglected, as in the thesis (L1677: it matters only at ~mT fields).
+//!   between particles is neglected, as in the thesis ([T000 §6.2.4]: it matters only at ~mT fields).
 //! * Field force `F = |m| ∇|B|` ([`crate::field::dipole_force`]), computed with the moments
 //!   from one field evaluation per particle; with no fibres the applied
 //!   field is uniform and exerts no force.

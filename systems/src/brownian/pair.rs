@@ -6,7 +6,7 @@
 //!   spheres; the thesis writes `2R`). For Mie(30, 15): C = 4, `r_min = 2^{1/15} σ = 1.0473 σ`
 //!   (2.0946 R), `U(σ) = ε`.
 //! * Point dipoles (eq. 6.21): `U = −μ0/(4π) [3 (r·m_i)(r·m_j)/r⁵ − m_i·m_j/r³]`; the force on
-//!   `i` with `r = x_i − x_j` (eq. 6.23 written out, spec §2.4):
+//!   `i` with `r = x_i − x_j` (eq. 6.23 written out, D-000-6):
 //!   `F_i = 3μ0/(4π r⁵) [(m_i·r) m_j + (m_j·r) m_i + (m_i·m_j) r − 5 (m_i·r)(m_j·r) r / r²]`.
 //!   Head to tail it is `−3 μ0 m² / (2π r⁴)` along r̂ (attractive).
 //!
@@ -163,7 +163,7 @@ mod tests {
         // U(2R) = ε, continuous to 0 at r_min
         assert!((mie.energy(2.0) - 100.0).abs() < 1e-10);
         assert!(mie.energy(rmin * (1.0 - 1e-9)).abs() < 1e-10);
-        // force at contact: 3000 kT/R for ε = 100 kT (spec 2.3)
+        // force at contact: 3000 kT/R for ε = 100 kT (D-000-7)
         assert!((mie.radial_force(2.0, 2.0) - 3000.0).abs() < 1e-9);
         // force = −∇U
         for r in [2.0, 2.03, 2.08] {
@@ -176,7 +176,7 @@ mod tests {
         let r = 2.05;
         let c = -(mie.radial_force(r + 1e-6, 2.0) - mie.radial_force(r - 1e-6, 2.0)) / 2e-6;
         assert!((mie.curvature(r, 2.0) - c).abs() < 1e-6 * c.abs());
-        // U = kT at r ≈ 2.081 R (spec 2.3)
+        // U = kT at r ≈ 2.081 R (D-000-7)
         let mut lo = 2.0;
         let mut hi = rmin;
         for _ in 0..100 {

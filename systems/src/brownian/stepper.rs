@@ -5,7 +5,7 @@
 //! **Why adaptive.** With the thesis's steps the explicit update is far beyond its stability
 //! limit once particles touch: `D h U''/k_BT` at a Mie(30, 15) contact is 16-9600 at
 //! `h = 5e-5 s`, and a dipole contact force moves a particle by up to 6 radii per step
-//! (spec §2.9, §4 item 14). Explicit Euler needs that number below 2.
+//! (D-000-10 in docs/references.md). Explicit Euler needs that number below 2.
 //!
 //! **The adaptive scheme** (Gaines and Lyons, SIAM J. Appl. Math. 57, 1455 (1997): variable
 //! steps on a Brownian tree). Each step `dt` starts with one Wiener increment `W` per particle.
@@ -21,7 +21,8 @@
 //! and an adaptive run of one seed see the same Wiener increments per `dt`.
 //!
 //! The mobility's square root `B` is frozen over one `dt` (it is built once per step from the
-//! start configuration); the drift `μ F(x)` is re-evaluated at every sub-step. With hydrodynamic
+//! start configuration); the drift `μ F(x)` is re-evaluated at every sub-step (with the
+//! user's external force kernels at the sub-step's time, see [`Dynamics::at_time`]). With hydrodynamic
 //! interactions this is first order in `dt`, like the thesis's scheme.
 //!
 //! Random numbers are drawn per particle in tree order, so the result does not depend on the

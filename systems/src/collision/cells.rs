@@ -1,5 +1,5 @@
 //! Candidate collision pairs for one step from a dense cell grid (Hoomans' "collision blocks",
-//! thesis L1520).
+//! [T002 §4.2.1.3]).
 //!
 //! Two spheres that touch at some time in a step, while every particle's speed stays below
 //! `v_max`, started at most `r_i + r_j + 2 v_max h` apart. With `reach = 2 v_max h + margin`, the

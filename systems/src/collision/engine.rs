@@ -1,5 +1,5 @@
-//! The event-driven hard-sphere collision step (thesis 002: ch. 2 L606–640 with Hoomans et al.'s
-//! sequence of binary collisions; ch. 4 L1518–1525).
+//! The event-driven hard-sphere collision step (thesis 002: ch. 2, §2.2.4.2, with Hoomans et al.'s
+//! sequence of binary collisions; ch. 4, §4.2.1.3).
 //!
 //! **Input.** Dense arrays in a stable particle order: start positions `x_n`, velocities `v` and
 //! angular velocities `Ω` *already updated by the force integrator for this step*, radii, inverse
@@ -9,8 +9,8 @@
 //! reset, counters).
 //!
 //! **Model.** Within the step the motion is ballistic, "the linear and angular velocities of the
-//! particles are assumed to change only due to collisions" (L1525), and sustained contacts are
-//! sequences of instantaneous binary collisions (L1527–1534). Every collision uses the impulse law
+//! particles are assumed to change only due to collisions" ([T002 §4.2.1.3]), and sustained contacts are
+//! sequences of instantaneous binary collisions ([T002 §4.2.1.3]). Every collision uses the impulse law
 //! of [`super::impulse`] with the coefficients from [`CollisionModel::law`] at the approach speed.
 //!
 //! **Algorithm.**

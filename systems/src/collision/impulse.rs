@@ -8,7 +8,7 @@
 //! lever arms `r_a`, `r_b` from the centres to one common contact point
 //! ([`super::toi::ContactGeometry`]).
 //!
-//! **Relative contact velocity** (sign convention \[D\] of the spheroid spec §6.3, the only one that
+//! **Relative contact velocity** (sign convention D-002-8 of docs/references.md, the only one that
 //! makes 4.12 and 4.14 consistent): `v_ab = (v_b + Ω_b×r_b) − (v_a + Ω_a×r_a)`; the bodies approach
 //! iff `v_ab·n < 0`. The impulse `J` acts on *b* and `−J` on *a* (4.12):
 //! `v_b += J/m_b`, `Ω_b += I_b⁻¹(r_b×J)`, `v_a −= J/m_a`, `Ω_a −= I_a⁻¹(r_a×J)`, so
@@ -20,21 +20,21 @@
 //! (`v⁻_t = v⁻ − (v⁻·n) n`).
 //! * Stick (4.14): `J = K⁻¹ (v⁺ − v⁻)`, accepted if `|J − (J·n) n| ≤ μ J·n` (4.15; the printed
 //!   "‖J − J·n‖" means the tangential part).
-//! * Slide (4.15, closed form of the spec): `J = J_n (n + μ t)`, `t = −v⁻_t/|v⁻_t|`,
+//! * Slide (4.15, closed form D-002-8): `J = J_n (n + μ t)`, `t = −v⁻_t/|v⁻_t|`,
 //!   `J_n = −(1 + e_n)(v⁻·n) / (n·K(n + μ t))`. Both regimes meet `v⁺·n = −e_n v⁻·n` exactly.
 //! * Separating or grazing pairs (`v⁻·n ≥ 0`) get no impulse.
 //!
 //! `e_t` is Hoomans' tangential restitution; `e_t = 0` is the ch. 4 model (no tangential
 //! restitution: sticking ends with zero tangential contact velocity). Static and dynamic friction
-//! are not distinguished (L1552). External loads during the impact are neglected (L1544).
+//! are not distinguished ([T002 §4.2.1.3]). External loads during the impact are neglected (ibid.).
 //!
 //! **Reduction to Hoomans (ch. 2).** For solid spheres `r_a ∥ r_b ∥ n`, so `K` is
 //! `(1/m_ab) n nᵀ + (7/2)(1/m_ab)(𝕀 − n nᵀ)` (`m_ab = m_a m_b/(m_a + m_b)`): the stick impulse is
 //! `J_n = −(1 + e_n) m_ab v⁻·n` (2.34) and `J_t = −(2/7)(1 + e_t) m_ab v⁻_t` (2.35, stick), the slide
-//! impulse has `|J_t| = μ J_n` (2.35, slide), and the Coulomb test is Hoomans'. Erratum: the printed
+//! impulse has `|J_t| = μ J_n` (2.35, slide), and the Coulomb test is Hoomans'. Erratum E-002-9b: the printed
 //! (2.33) `m_a(v_a⁺ − v_a⁻) = −m_b(v_b⁻ − v_b⁺) = J` gives both spheres the same impulse and does not
 //! conserve momentum; the consistent form `m_a Δv_a = J_H = −m_b Δv_b` is used (Hoomans' `J_H` is our
-//! `−J`, his normal points from *b* to *a*). The restitution ratios printed at L618/L624 are
+//! `−J`, his normal points from *b* to *a*). The restitution ratios printed after (2.34) and (2.35) (erratum E-002-9c) are
 //! inverted; `e = −(v⁺·n)/(v⁻·n)` is meant.
 //!
 //! **Choices where the thesis is silent.**

@@ -15,7 +15,7 @@
 //! * `cells` (private): candidate pairs from a cell grid.
 //!
 //! Deviations from the thesis (errata and filled gaps) are listed in each module header: the
-//! momentum-conserving sign of (2.33), the inverted restitution ratios (L618/L624), the clamp of
+//! momentum-conserving sign of (2.33), the inverted restitution ratios (erratum E-002-9c), the clamp of
 //! (2.36) below its threshold, the wall and unequal-sphere Stokes numbers, the rest speed, the
 //! resting-contact solve, the approach tolerance, the event cap and the overlap projection.
 

@@ -1,14 +1,14 @@
 //! Wet normal restitution (Izard et al., thesis 002 eq. 2.36) and the collision-law provider
 //! [`CollisionModel`].
 //!
-//! **Binary normal Stokes number** (L626–630): `St_n = (2/9)(ρ*/ρ_f) Re_rel`, with the reduced
+//! **Binary normal Stokes number** ([T002 §2.2.4.2]): `St_n = (2/9)(ρ*/ρ_f) Re_rel`, with the reduced
 //! density `ρ* = (1/ρ_1 + 1/ρ_2)⁻¹` and `Re_rel = d u_n/ν` (`u_n` the normal approach speed of the
 //! contact points, `ν` the kinematic viscosity).
 //!
 //! **Izard et al. correlation** (2.36):
 //! `e_eff/e_dry = (1 + ln(2η_e/d)/St) exp(−(π/2)/√(St + ln(2η_e/d)))`, `η_e` the effective roughness.
 //! Since `ln(2η_e/d) < 0`, the formula is defined only for `St > −ln(2η_e/d)` (7.42 for
-//! `η_e = 1.5 µm`, `d = 5 mm`); below that threshold `e_eff = 0` (spheres spec §3.3 \[CHECK\]),
+//! `η_e = 1.5 µm`, `d = 5 mm`); below that threshold `e_eff = 0` (D-002-6 in docs/references.md),
 //! and it is clamped to `[0, e_dry]` (it never exceeds `e_dry` for `η_e < d/2` anyway).
 //! Examples (`e_dry = 0.86`, `η_e = 1.5 µm`, `d = 5 mm`): `St = 10 → e ≈ 0.084`,
 //! `St = 14 → e ≈ 0.22`.
@@ -17,7 +17,7 @@
 //! * *Unequal spheres:* `d` is the harmonic-mean diameter `d* = 2 d_1 d_2/(d_1 + d_2)` (twice the
 //!   reduced radius times 2, i.e. `4 r_1 r_2/(r_1 + r_2)`), which is `d_p` for equal spheres, the only
 //!   case the thesis uses. The same `d*` enters `Re_rel` and the roughness ratio `2η_e/d*`.
-//! * *Wall collisions* (the thesis gives only the particle–particle form, L630): `ρ_2 → ∞`, so
+//! * *Wall collisions* (the thesis gives only the particle–particle form, [T002 eq. 2.36]): `ρ_2 → ∞`, so
 //!   `ρ* = ρ_p`, and `d = d_p` (the particle's own diameter, not the `d* → 2 d_p` limit, so that the
 //!   roughness ratio stays the particle's). Note that this wall Stokes number
 //!   `(2/9)(ρ_p/ρ_f) Re` is twice the usual wall definition `(1/9)(ρ_p/ρ_f) Re` of Joseph et al.
@@ -186,12 +186,12 @@ pub enum CollisionModelError {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CollisionModel {
-    /// Normal restitution model. Default: `Wet { dry_normal: 0.85, roughness: 1.5e-6 }` (L887).
+    /// Normal restitution model. Default: `Wet { dry_normal: 0.85, roughness: 1.5e-6 }` ([T002 §2.5.3]).
     pub restitution: Restitution,
     /// Tangential restitution `e_t` (stick regime) [-]. Default: 0 (ch. 4; ch. 2 runs all slide).
     /// Range: [−1, 1].
     pub tangential_restitution: f64,
-    /// Coulomb friction coefficient μ [-]. Default: 0.005 (L887; ch. 4 uses 0.05). Range: ≥ 0.
+    /// Coulomb friction coefficient μ [-]. Default: 0.005 ([T002 §2.5.3]; ch. 4 uses 0.05). Range: ≥ 0.
     pub friction: f64,
     /// Approaches slower than this are fully inelastic, `e_n = e_t = 0`; it is also the speed
     /// scale of the engine's resting contacts [m/s]. Default: 0.01 (below the Izard threshold of

@@ -1,10 +1,10 @@
 //! Time of impact (TOI) and contact geometry of ballistically moving hard particles.
 //!
 //! Within a solver step the linear and angular velocities change only through collisions
-//! (thesis 002, L1525), so between two events each particle moves ballistically:
+//! ([T002 §4.2.1.3]), so between two events each particle moves ballistically:
 //! `x(t) = x₀ + v t`, and a spheroid would also rotate at constant Ω.
 //!
-//! **Sphere–sphere** (Hoomans et al. 1996; thesis L1525: "found analytically by solving a
+//! **Sphere–sphere** (Hoomans et al. 1996; [T002 §4.2.1.3]: "found analytically by solving a
 //! quadratic equation"). With `Δx = x_b − x_a`, `Δv = v_b − v_a` and `s = r_a + r_b`, contact is
 //! `|Δx + Δv t|² = s²`, i.e. `a t² + 2 b t + c = 0` with `a = Δv·Δv`, `b = Δx·Δv`,
 //! `c = Δx·Δx − s²`. The pair approaches iff `b < 0`. The earliest root is evaluated in the
@@ -37,8 +37,8 @@
 //! [`CollisionShape::time_of_impact`] would use [`Ballistic::orientation`] and
 //! [`Ballistic::angular_velocity`], computing the minimum distance (Jain et al.'s common normal, or
 //! the Perram–Wertheim contact function) inside a bisection/conservative-advancement search with
-//! the thesis tolerance `ε_t = 0.001 dt` (L1525); the spheroid–plane distance has the closed form
-//! `d = n_w·(x_c − x_w) − √(n_wᵀ E⁻¹ n_w)` (spheroid spec §6.2). [`CollisionShape::contact`] would
+//! the thesis tolerance `ε_t = 0.001 dt` ([T002 §4.2.1.3]); the spheroid–plane distance has the closed form
+//! `d = n_w·(x_c − x_w) − √(n_wᵀ E⁻¹ n_w)` (D-002-9 in docs/references.md). [`CollisionShape::contact`] would
 //! return the common-normal contact. The sphere paths stay analytic.
 
 use glam::{DQuat, DVec3};

@@ -2,7 +2,7 @@
 //!
 //! `cel(kc, p, a, b) = ∫₀^{π/2} (a cos²φ + b sin²φ) / ((cos²φ + p sin²φ) √(cos²φ + kc² sin²φ)) dφ`
 //!
-//! (Bulirsch 1965; the form of Derby & Olbert 2010 and the spec, section 1.9). The finite
+//! (Bulirsch 1965; the form of Derby & Olbert 2010 and D-000-1 in docs/references.md). The finite
 //! cylinder's field needs it at two values of `p` (1 and γ²) and two numerators each, all with
 //! the same `kc`: [`cel_cylinder_pair`] runs the shared Gauss-Landen iteration (the `kc` sequence and
 //! its square roots) once for all four.
@@ -193,7 +193,7 @@ mod tests {
         // E(m = 1/2) = cel(kc, 1, 1, kc^2)
         let kc = 0.5f64.sqrt();
         assert!((cel(kc, 1.0, 1.0, 0.5) - 1.350_643_881_047_675_5).abs() < 1e-15);
-        // spec 1.4: P2 = C(k, γ², 1, -γ) at k = 0.5, γ = 0.3 is -0.6505 (the printed +γ gives 3.668)
+        // erratum E-000-15: P2 = C(k, γ², 1, -γ) at k = 0.5, γ = 0.3 is -0.6505 (the printed +γ gives 3.668)
         let p2 = cel(0.5, 0.09, 1.0, -0.3);
         assert!((p2 - (-0.6505)).abs() < 5e-5, "{p2}");
         assert!(cel(KC_MIN * 0.0, 1.0, 1.0, 1.0).is_finite());

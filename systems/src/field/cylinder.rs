@@ -1,7 +1,7 @@
 //! Field of a uniformly magnetised finite circular cylinder in its body frame (axis z, centre
 //! at the origin, radius `R`, **half** length `L`): thesis 000 ch. 5, eqs. 5.3-5.6
-//! (longitudinal) and 5.19-5.22 (transverse), in the stable Bulirsch `cel` form of the spec
-//! (section 1.9), with an exact near-axis branch.
+//! (longitudinal) and 5.19-5.22 (transverse), in the stable Bulirsch `cel` form of D-000-1
+//! (docs/references.md), with an exact near-axis branch.
 //!
 //! ## Formulation
 //! A uniform magnetisation `M` gives `H = Hess(Ψ) · M`, where `Ψ(r) = ∫_V dV'/(4π|r - r'|)` is
@@ -22,7 +22,7 @@
 //! replaces the thesis's `P₄`, which is therefore never evaluated (eq. 5.21's `H_ρ` is
 //! `M_t cos φ Ψ_ρρ`; the tests check the identity against `P₄`).
 //! `P₁ = cel(k,1,1,-1)`, `P₂ = cel(k,γ²,1,-γ)` (**the thesis's appendix 5.A prints `+γ`, a
-//! typo: spec E, section 1.4**), `P₃ = cel(k,1,0,1) - γ² cel(k,γ²,0,1)`.
+//! typo: erratum E-000-15**), `P₃ = cel(k,1,0,1) - γ² cel(k,γ²,0,1)`.
 //!
 //! ## Delicate places (all handled on purpose; never NaN or inf)
 //! * **Axis.** `b` carries `1/ρ` times a difference that vanishes like `ρ`, so the `cel` form

@@ -1,4 +1,4 @@
-//! Tests of the body-frame kernel: golden values (spec 1.11, 40-digit mpmath), identities and
+//! Tests of the body-frame kernel: golden values (D-000-2 in docs/references.md, 40-digit mpmath), identities and
 //! limits. Comparisons with independent quadrature are in `tests/field_reference.rs`.
 
 use super::*;

@@ -1,5 +1,5 @@
 //! Magnetometric demagnetising factors of a finite cylinder and the Stoner-Wohlfarth
-//! magnetisation direction of a saturated fibre in an external field (spec 2.6; the thesis
+//! magnetisation direction of a saturated fibre in an external field (D-000-4 in docs/references.md; the thesis
 //! cites Stoner-Wohlfarth but gives no formula).
 //!
 //! **Demagnetising factor.** The magnetostatic energy of the end-face charges `±M` is
@@ -51,7 +51,7 @@ pub(crate) fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
 ///
 /// ```
 /// use magsep_systems::field::demag::axial_demag_factor;
-/// // L/D = 1 (half length = radius): 0.31158 (spec 1.11)
+/// // L/D = 1 (half length = radius): 0.31158 (D-000-3)
 /// assert!((axial_demag_factor(1.0, 1.0) - 0.31158).abs() < 1e-5);
 /// ```
 pub fn axial_demag_factor(radius: f64, half_length: f64) -> f64 {
@@ -167,7 +167,7 @@ mod tests {
 
     #[test]
     fn demag_factors_match_spec_table() {
-        // spec 1.11: L/D (full length / diameter) -> N_z
+        // D-000-3: L/D (full length / diameter) -> N_z
         for (ld, nz) in [
             (1.0, 0.31158),
             (5.0 / 3.0, 0.21148),
@@ -189,7 +189,7 @@ mod tests {
     fn stoner_wohlfarth_angles_match_spec_table() {
         let ms = 985e3;
         let h = 1.0 / MU0;
-        // spec 2.6, L/D = 20: α -> θ [deg]
+        // D-000-4, L/D = 20: α -> θ [deg]
         let nz = axial_demag_factor(1.0, 20.0);
         let nx = 0.5 * (1.0 - nz);
         for (a, t) in [

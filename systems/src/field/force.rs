@@ -1,5 +1,5 @@
 //! Force on a superparamagnetic point dipole: moment along the local field,
-//! `F = ∇(m · B) = |m|(|B|) ∇|B|` (spec 1.10; thesis eq. 6.20 with `m ∥ B`).
+//! `F = ∇(m · B) = |m|(|B|) ∇|B|` (D-000-5; thesis eq. 6.20 with `m ∥ B`).
 //!
 //! `∇|B| = (∇B)ᵀ B̂`. For an induced moment whose magnitude depends on `|B|` only (Langevin), the
 //! force from the free energy is again `|m| ∇|B|`. Where `B = 0` the direction is undefined and

@@ -1,6 +1,6 @@
 //! Magnetic fields of magnetised fibres: the exact field, gradient and force of uniformly
 //! magnetised finite cylinders (thesis 000, ch. 5), demagnetising factors and the
-//! Stoner-Wohlfarth magnetisation direction (spec 2.6).
+//! Stoner-Wohlfarth magnetisation direction (D-000-4 in docs/references.md).
 //!
 //! * [`cel`]: Bulirsch's generalised complete elliptic integral (fused for the cylinder).
 //! * [`cylinder`]: the body-frame kernel (closed form, near-axis expansion).

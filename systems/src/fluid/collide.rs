@@ -17,7 +17,7 @@ use crate::collision::{CollisionEngine, CollisionModel, InverseInertia, Particle
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CollisionHistory {
-    /// The thesis (eq. 2.29, L586): discard the pre-collision history and keep the collision's
+    /// The thesis (eq. 2.29, [T002 §2.2.4.1]): discard the pre-collision history and keep the collision's
     /// jump term `(v(t_c⁻) − v(t_c⁺))/√(t − t_c)`, at every collision, resting contacts
     /// included ("sustained contacts are sequences of collisions").
     #[default]

@@ -94,7 +94,7 @@ pub enum Integrator {
     #[default]
     Implicit,
     /// The thesis's forward Euler: every force at the start of the step, the history from
-    /// completed steps only. Unstable for Δt > 2τ_eff or small particles (spec §2.3).
+    /// completed steps only. Unstable for Δt > 2τ_eff or small particles (D-002-2).
     Explicit,
 }
 

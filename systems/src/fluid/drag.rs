@@ -1,5 +1,5 @@
 //! Steady translational and rotational drag of a sphere (thesis 002, eq. 2.26 and
-//! eq. 2.31-2.32; spec `density-separation-spheres.md` §2.1).
+//! eq. 2.31-2.32; erratum E-002-9a).
 //!
 //! Translational (Schiller & Naumann 1933): `F_D = 3πμd (1 + 0.15 Re^0.687) (u − v)`,
 //! `Re = d|u − v|/ν` (the thesis writes it as `ρ_p V (u − v)/τ_t (…)` with
@@ -7,7 +7,7 @@
 //!
 //! Rotational (Dennis et al. 1980): `T = C_T ½ ρ_f R⁵ |Δ| Δ`, `Δ = ½ω − Ω`,
 //! `Re_r = d²|Δ|/ν`, `C_T = 64π/Re_r` (Re_r ≤ 32) or `12.9/√Re_r + 128.4/Re_r`
-//! (32 < Re_r < 1000; used beyond 1000 too, where no data exist). Erratum (spec §8 item 9):
+//! (32 < Re_r < 1000; used beyond 1000 too, where no data exist). Erratum E-002-9a:
 //! eq. 2.31 prints ρ_p and a leading minus that makes the torque anti-damping; with ρ_f and
 //! Δ = ½ω − Ω the low-Re limit is the exact Stokes torque 8πμR³Δ.
 //!

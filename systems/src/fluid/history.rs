@@ -4,7 +4,7 @@
 //! ## Equations
 //! With the slip `w(t) = u(x_p(t), t) − v(t)` (fluid velocity at the particle minus particle
 //! velocity), the Basset force of the extended Maxey–Riley equation (thesis 002 eq. 2.26,
-//! spec section 2.1) with the step-change terms of eqs. 2.27–2.29 is `F_H = c_H · I(t)`,
+//! [T002 §2.2.4.1]) with the step-change terms of eqs. 2.27–2.29 is `F_H = c_H · I(t)`,
 //!
 //! ```text
 //! I(t) = ∫_{t_s}^{t} (dw/dτ) (t − τ)^{−1/2} dτ  +  J_s (t − t_s)^{−1/2},
@@ -14,7 +14,7 @@
 //! where `(t_s, J_s)` is the last step change of the slip: the start `t_s = t0` with
 //! `J_s = w(t0)` (eq. 2.27), or a collision at `t_c` with `J = w(t_c⁺) − w(t_c⁻) =
 //! v(t_c⁻) − v(t_c⁺)`, after which **all pre-collision history is discarded** (eq. 2.29, the
-//! thesis's modelling choice "the pre-collision history can be set to zero", L586).
+//! thesis's modelling choice "the pre-collision history can be set to zero", [T002 §2.2.4.1]).
 //!
 //! **Product integration.** On a uniform grid `t_k = t_origin + kΔt` the slope
 //! `g_k = Δw_k/Δt`, `Δw_k = w_{k+1} − w_k`, is taken constant on `[t_k, t_{k+1}]` (`w`
@@ -55,7 +55,7 @@
 //!   the singular kernel near `s = 0`); it is exact for piecewise-linear `w` (tested: measured
 //!   order 1.5).
 //! * The tail kernel's relative error (measured) is `6.1e-5` at `s = t_win`, `≤ 0.28 %` on
-//!   `[t_win, 30 t_win]` (maximum at `7.9 t_win`; the spec's 0.2 % is slightly optimistic),
+//!   `[t_win, 30 t_win]` (maximum at `7.9 t_win`; the 0.2 % of D-002-4 is slightly optimistic),
 //!   `≤ 0.7 %` up to `100 t_win` and `≤ 3.3 %` up to `1000 t_win`, so the tail's error is that
 //!   fraction of the (small) old-history contribution. Over `10⁴` steps with `N_w = 100` the
 //!   window + tail stays within `3e-3 max|I|` of the full memory; the truncated window is off
@@ -67,13 +67,13 @@
 //! ## Assumptions
 //! * Uniform step `Δt` ([`HistoryPlan`]); a variable step needs a new plan and a restarted
 //!   state (the buffer's lags are in units of `Δt`).
-//! * Classic Basset kernel (no finite-Re kernel, thesis L562).
+//! * Classic Basset kernel (no finite-Re kernel, [T002 §2.2.4.1]).
 //! * After a collision during the step `[t_n, t_{n+1}]` the slip is taken constant from `t_c`
 //!   to `t_{n+1}` (the buffer restarts at the step boundary), while the jump term uses the true
 //!   `t_c` ([`HistoryState::reset_at_collision`]).
 //!
 //! ## Use by an integrator
-//! * **Implicit** newest weight (stable for small particles, spec section 2.3):
+//! * **Implicit** newest weight (stable for small particles, D-002-2):
 //!   `F_H(t_{n+1}) = c_H (past_integral(t_{n+1}) + c_0 (w_{n+1} − w_n))` with
 //!   `c_0 =` [`HistoryPlan::newest_weight`]; the `c_H c_0` part moves to the effective mass.
 //! * **Explicit** (the thesis's forward Euler): `F_H(t_n) = c_H current_integral(t_n)`.

@@ -80,7 +80,7 @@ fn tail_kernel_error_bounds() {
         "tail kernel rel. error: s=t_win {at_win:.2e}, <=30 {m30:.2e}, <=100 {m100:.2e}, <=1000 {m1000:.2e}"
     );
     assert!(at_win <= 1e-4, "{at_win}");
-    // the spec's [CHECK] says 0.2 %; the true maximum is 0.278 % at s = 7.86 t_win
+    // D-002-4 says 0.2 %; the true maximum is 0.278 % at s = 7.86 t_win
     assert!(m30 <= 3e-3, "{m30}");
     assert!(m100 <= 1e-2, "{m100}");
     assert!(m1000 <= 5e-2, "{m1000}");

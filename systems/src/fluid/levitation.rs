@@ -1,5 +1,5 @@
 //! Linear stability of magneto-Archimedes levitation and the levitation time (thesis 002,
-//! §2.5.1, eq. 2.45-2.50; spec `density-separation-spheres.md` §1.5, §2.2).
+//! §2.5.1, eq. 2.45-2.50; errata E-002-4, E-002-5, E-002-7 in docs/references.md).
 //!
 //! Linearised about y_e without history and with Stokes drag, a sphere obeys
 //! `m_eff ÿ = −k ẏ − κ (y − y_e)` with `m_eff = (ρ_p + ½ρ_f) V` (or `ρ_p V` without added
@@ -8,9 +8,9 @@
 //! critical diameter solves `k² = 4 m_eff κ`:
 //! `d⁴ = 81 μ² / (c_m g |dρ_{f,a}/dy|)`, `c_m = ρ_p + ½ρ_f` (or ρ_p). For one magnet this is
 //! eq. 2.50 with |ρ_p − ρ_f| (the printed table 2.2 swaps the signs); the thesis's quoted
-//! 3.2 mm is the criterion without added mass (L758), eq. 2.50 gives 2.9 mm (spec §1.5).
+//! 3.2 mm is the criterion without added mass ([T002 §2.5.1.1]), eq. 2.50 gives 2.9 mm (erratum E-002-7).
 //!
-//! Levitation time (L791): `t_l = max{t : |y(t) − y_e| = tol}`, tol = 0.5 mm in the thesis.
+//! Levitation time ([T002 §2.5.1.1]): `t_l = max{t : |y(t) − y_e| = tol}`, tol = 0.5 mm in the thesis.
 
 use super::magnet::{Liquid, MagnetModel};
 

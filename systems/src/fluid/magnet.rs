@@ -1,5 +1,5 @@
 //! Quasi-static ferrohydrodynamics of a paramagnetic liquid above/between Halbach magnets
-//! (thesis 002, ch. 1-2; spec `density-separation-spheres.md` §1.2-1.5).
+//! (thesis 002, ch. 1-2; see docs/references.md).
 //!
 //! The field of an ideal Halbach array decays exponentially from its strong face with the
 //! pole size p (eq. 2.6-2.8; 1-D, `H = H(y) e_y`):
@@ -15,16 +15,16 @@
 //! "magnetic buoyancy" is `−μ₀ V χ H dH/dy e_y`. A particle levitates where
 //! `ρ_{f,a}(y_e) = ρ_p` (eq. 2.14).
 //!
-//! Errata implemented here (spec §8): the equilibrium heights of table 2.2 are replaced by the
+//! Errata implemented here (E-002-5, E-002-6, E-002-7): the equilibrium heights of table 2.2 are replaced by the
 //! forms derived from eq. 2.17-2.19 (the printed ones measure from the magnet face, carry 2π
 //! for π, and lack e^{2πL/p} for two magnets); the two-magnet resolution (eq. 2.23) uses
 //! 2π², not 4π² (only 2π² gives the thesis's own 0.97 ρ_f/L); the critical diameter keeps the
 //! added-mass factor ξ of eq. 2.50 unless asked not to (the thesis's quoted 3.2 mm is the
-//! criterion without ξ, L758).
+//! criterion without ξ, [T002 §2.5.1.1]).
 //!
 //! The point value of the force density is used over the particle volume; for an exponential
 //! field the exact volume average is larger by `3(κR cosh κR − sinh κR)/(κR)³ ≈ 1 + (κR)²/10`
-//! (κ = 2π/p): 0.26 % for a 6 mm sphere in the table 2.1 rig (spec §1.2).
+//! (κ = 2π/p): 0.26 % for a 6 mm sphere in the table 2.1 rig (D-002-1).
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -225,7 +225,7 @@ impl MagnetModel {
     }
 
     /// Equilibrium height y_e [m] of a particle of density `particle_density` [kg/m³] from the
-    /// closed forms (derived from eq. 2.17-2.19; the printed table 2.2 is wrong, spec §1.5).
+    /// closed forms (derived from eq. 2.17-2.19; the printed table 2.2 is wrong, erratum E-002-5).
     /// `None` when the particle does not levitate in the valid range.
     ///
     /// ```
@@ -399,7 +399,7 @@ mod tests {
             m.equilibrium_height_by_root(&liquid, 9.81, 1300.0)
                 .is_none()
         );
-        // the ten density groups of the many-particle runs (spec table)
+        // the ten density groups of the many-particle runs (D-002-7)
         let (liquid, two) = table_2_3();
         // ratios 0.7 + 0.6 k / 9 (ten evenly spaced groups)
         for (k, expect) in [0.876, 0.774, 0.641, 0.456, 0.178].into_iter().enumerate() {

@@ -1,5 +1,5 @@
-//! The particle equation of motion (thesis 002, eq. 2.24-2.26 and 2.30, corrected; spec
-//! `density-separation-spheres.md` §2) and its time stepping.
+//! The particle equation of motion (thesis 002, eq. 2.24-2.26 and 2.30, corrected; see
+//! docs/references.md) and its time stepping.
 //!
 //! ```text
 //! (m + ½ρ_f V) dv/dt = F_G + F_B + F_MB + F_D + F_H + (ρ_f V + ½ρ_f V) Du/Dt + F_c
@@ -13,7 +13,7 @@
 //!   contribution at the start of the step (the drag at v_n, the history of completed steps
 //!   seen from t_{n+1}), k the drag's secant stiffness and `c_H c₀ = c_H 2/√Δt` the newest
 //!   history weight. The thesis's explicit scheme is unstable once
-//!   `r = 18 √(ρ_f μ Δt/π)/((ρ_p + ½ρ_f) d) ≳ 1.3` (history, spec §2.3) or `Δt > 2τ_eff` (drag);
+//!   `r = 18 √(ρ_f μ Δt/π)/((ρ_p + ½ρ_f) d) ≳ 1.3` (history, D-002-2) or `Δt > 2τ_eff` (drag);
 //!   this one is not (tested). First order in Δt; the history quadrature is O(Δt^{3/2}).
 //! * **Explicit**: forward Euler `M (v_{n+1} − v_n) = Δt F_n` with the history at t_n.
 //!

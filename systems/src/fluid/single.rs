@@ -1,5 +1,5 @@
 //! One sphere moving vertically in a quiescent magnetised liquid: the reduced system of
-//! thesis 002, eq. 2.41-2.46 (corrected, spec §2.2), integrated with the same kernels and
+//! thesis 002, eq. 2.41-2.46 (corrected, erratum E-002-4), integrated with the same kernels and
 //! the same step as the particle-fluid pipeline (`motion`, `drag`, `history`). It serves the
 //! single-particle studies (levitation time against diameter, history effects, the critical
 //! diameter by direct integration) and the validation against the exact unsteady-Stokes

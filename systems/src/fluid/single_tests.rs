@@ -110,8 +110,8 @@ fn without_history_the_step_is_first_order_exact_relaxation() {
 
 #[test]
 fn window_matches_full_memory_in_levitation_time_and_thesis_ratios_hold() {
-    // spec 7.5: windowed vs full memory within 1 % in t_l; t_l(no history)/t_l(history) for
-    // the 5 mm PVC-U particle: 0.53 ± 0.05 rising, 0.64 ± 0.05 sinking (thesis V9-V10)
+    // V-DS-5: windowed vs full memory within 1 % in t_l; t_l(no history)/t_l(history) for
+    // the 5 mm PVC-U particle: 0.53 ± 0.05 rising, 0.64 ± 0.05 sinking (V-DS-R9, V-DS-R10)
     let mut s = SphereInLiquid::table_2_1(5e-3);
     let y_e = s
         .magnet
@@ -145,7 +145,7 @@ fn window_matches_full_memory_in_levitation_time_and_thesis_ratios_hold() {
 
 #[test]
 fn levitation_times_against_diameter_have_their_minimum_near_4_mm() {
-    // spec 7.4 [CHECK]: 23.1 / 6.44 / 1.69 / 2.98 s at 1 / 2 / 4 / 6 mm (no history, y0 = −0.9 L)
+    // V-DS-4, D-002-5: 23.1 / 6.44 / 1.69 / 2.98 s at 1 / 2 / 4 / 6 mm (no history, y0 = −0.9 L)
     let expect = [(1e-3, 23.1), (2e-3, 6.44), (4e-3, 1.69), (6e-3, 2.98)];
     let mut times = Vec::new();
     for (d, t_ref) in expect {
@@ -165,7 +165,7 @@ fn levitation_times_against_diameter_have_their_minimum_near_4_mm() {
 
 #[test]
 fn explicit_history_weights_diverge_for_small_particles_and_the_implicit_step_does_not() {
-    // spec 2.3: explicit history diverges once 0.76 r > 1 − Δt/(2τ_eff); for MnCl2 at 1 ms that
+    // D-002-2: explicit history diverges once 0.76 r > 1 − Δt/(2τ_eff); for MnCl2 at 1 ms that
     // is d ≲ 0.38 mm. The implicit newest weight stays stable down to at least 0.07 mm.
     let run = |d: f64, integrator: Integrator| {
         let mut s = SphereInLiquid::table_2_1(d);

@@ -61,7 +61,6 @@
 //! ```
 
 use std::f64::consts::PI;
-use std::ops::{Add, Div, Mul, Sub};
 
 use serde::{Deserialize, Serialize};
 
@@ -69,92 +68,24 @@ use serde::{Deserialize, Serialize};
 /// `f64`).
 pub const TALBOT_NODES: usize = 20;
 
-/// Minimal complex number for the Laplace inversion.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Complex {
-    re: f64,
-    im: f64,
-}
+/// Complex numbers of the Laplace inversion (`num-complex`; divisions and reciprocals use
+/// its scaled `fdiv`/`finv`, which do not overflow for large components).
+type Complex = num_complex::Complex64;
 
-impl Complex {
-    const fn new(re: f64, im: f64) -> Self {
-        Complex { re, im }
+/// Principal square root (branch cut on the negative real axis) without cancellation.
+/// Kept by hand: `num_complex`'s `sqrt` goes through polar form, which near the cut loses
+/// the small component entirely (`sqrt(-4 + 1e-30 i)` gets re = 1.2e-16 instead of 2.5e-31).
+fn principal_sqrt(z: Complex) -> Complex {
+    let m = z.norm();
+    if m == 0.0 {
+        return Complex::new(0.0, 0.0);
     }
-
-    fn exp(self) -> Self {
-        let m = self.re.exp();
-        let (sin, cos) = self.im.sin_cos();
-        Complex::new(m * cos, m * sin)
-    }
-
-    /// Principal square root (branch cut on the negative real axis), without cancellation.
-    fn sqrt(self) -> Self {
-        let m = self.re.hypot(self.im);
-        if m == 0.0 {
-            return Complex::new(0.0, 0.0);
-        }
-        if self.re >= 0.0 {
-            let r = (0.5 * (m + self.re)).sqrt();
-            Complex::new(r, self.im / (2.0 * r))
-        } else {
-            let i = (0.5 * (m - self.re)).sqrt().copysign(self.im);
-            Complex::new(self.im / (2.0 * i), i)
-        }
-    }
-
-    fn recip(self) -> Self {
-        // Smith's algorithm (no overflow for large components)
-        if self.re.abs() >= self.im.abs() {
-            let q = self.im / self.re;
-            let d = self.re + self.im * q;
-            Complex::new(1.0 / d, -q / d)
-        } else {
-            let q = self.re / self.im;
-            let d = self.re * q + self.im;
-            Complex::new(q / d, -1.0 / d)
-        }
-    }
-}
-
-impl Add for Complex {
-    type Output = Complex;
-    fn add(self, o: Complex) -> Complex {
-        Complex::new(self.re + o.re, self.im + o.im)
-    }
-}
-
-impl Sub for Complex {
-    type Output = Complex;
-    fn sub(self, o: Complex) -> Complex {
-        Complex::new(self.re - o.re, self.im - o.im)
-    }
-}
-
-impl Mul for Complex {
-    type Output = Complex;
-    fn mul(self, o: Complex) -> Complex {
-        Complex::new(
-            self.re * o.re - self.im * o.im,
-            self.re * o.im + self.im * o.re,
-        )
-    }
-}
-
-impl Mul<f64> for Complex {
-    type Output = Complex;
-    fn mul(self, o: f64) -> Complex {
-        Complex::new(self.re * o, self.im * o)
-    }
-}
-
-impl Div for Complex {
-    type Output = Complex;
-    fn div(self, o: Complex) -> Complex {
-        let r = o.recip();
-        Complex::new(
-            self.re * r.re - self.im * r.im,
-            self.re * r.im + self.im * r.re,
-        )
+    if z.re >= 0.0 {
+        let r = (0.5 * (m + z.re)).sqrt();
+        Complex::new(r, z.im / (2.0 * r))
+    } else {
+        let i = (0.5 * (m - z.re)).sqrt().copysign(z.im);
+        Complex::new(z.im / (2.0 * i), i)
     }
 }
 
@@ -358,11 +289,11 @@ impl StokesRelease {
     /// `V(s)` [m] (velocity transform, m/s · s).
     fn velocity_transform(&self, s: Complex) -> Complex {
         let m = self.effective_mass();
-        let num = s.recip() * self.force + Complex::new(m * self.initial_velocity, 0.0);
+        let num = s.finv() * self.force + Complex::new(m * self.initial_velocity, 0.0);
         let den = s * m
-            + s.sqrt() * (self.history_coefficient() * PI.sqrt())
+            + principal_sqrt(s) * (self.history_coefficient() * PI.sqrt())
             + Complex::new(self.drag_coefficient(), 0.0);
-        num / den
+        num.fdiv(den)
     }
 
     /// Velocity `v(t)` [m/s] at time `t` [s] after release (`v0` for `t ≤ 0`, `v_∞` for
@@ -403,7 +334,7 @@ impl StokesRelease {
         } else if t.is_infinite() {
             self.terminal_velocity() * t
         } else {
-            talbot(|s| self.velocity_transform(s) / s, t, TALBOT_NODES)
+            talbot(|s| self.velocity_transform(s).fdiv(s), t, TALBOT_NODES)
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Thin ECS glue of the particle-fluid pipeline: each system reads components, calls the
-//! kernels of [`crate::fluid`] and writes its own contribution (house plan, section 2).
+//! kernels of [`crate::fluid`] and writes its own contribution (docs/architecture.md §2, schedule).
 //!
 //! Vertical is z (the thesis's y): gravity −g e_z, the magnet model's y = z − `mid_plane`.
 //!

@@ -5,7 +5,7 @@
 //! quadratic in (s, t): its minimum is the interior stationary point when that lies in the
 //! rectangle [-h_i, h_i] x [-h_j, h_j], and otherwise on one of the four edges, where a
 //! clamped projection is exact. This is exact to round-off for every pair, including nearly
-//! parallel ones, where the spec's "clamp, project, clamp" (Alg. S) and a mid-point rule are off
+//! parallel ones, where the "clamp, project, clamp" shortcut (D-000-21) and a mid-point rule are off
 //! by up to angle x length. Exactly parallel segments with overlapping projections (a line
 //! contact) take the middle of the overlap, so the contact point is symmetric.
 

@@ -16,7 +16,7 @@
 //! T(p,q,r) = G(1+p/g1) G(1+q/g2) G(1+r/g3) / G(1 + p/g1 + q/g2 + r/g3),
 //!
 //! the thesis's Gamma(eps/2) form rewritten with eps G(eps/2) = 2 G(1 + 1/g) (exact). The
-//! bounding radius is the maximum of |x| on the surface (erratum E7): closed form 4.38/4.39
+//! bounding radius is the maximum of |x| on the surface (erratum E-000-7): closed form 4.38/4.39
 //! for equal exponents (max a_i at g = 2, where 4.38 is singular), a numerical upper bound
 //! tight to round-off for unequal exponents.
 
@@ -143,7 +143,7 @@ mod tests {
 
     #[test]
     fn thesis_table_values() {
-        // spec packing.md 2.1: Lambda = 5 (L = 4, R = 1/2): V = 3.6652, I_x/m = 1.8893, I_z/m = 0.1214
+        // D-000-13: Lambda = 5 (L = 4, R = 1/2): V = 3.6652, I_x/m = 1.8893, I_z/m = 0.1214
         let s = Shape::Spherocylinder {
             radius: 0.5,
             half_length: 2.0,
@@ -170,7 +170,7 @@ mod tests {
         }
     }
 
-    /// Superball table of spec packing.md 2.2 (a = 1): g, V, I_xx, I/V, r_bound.
+    /// Superball reference table D-000-14 (a = 1): g, V, I_xx, I/V, r_bound.
     const SUPERBALL_TABLE: [(f64, f64, f64, f64, f64); 7] = [
         (2.0, 4.18879, 1.67552, 0.4000, 1.00000),
         (2.5, 5.07159, 2.31301, 0.4561, 1.11612),

@@ -1,9 +1,9 @@
-//! The compression driver (thesis 000, Alg. A): volume steps with revert and halving.
+//! The compression driver ([T000 §2.2.1, §3.2]): volume steps with revert and halving.
 //!
 //! Each step saves the last overlap-free state, removes a volume dV from the container by an
 //! affine scaling of all centres along the container's compressed axes (all three for the
 //! periodic cube and the closed box; z only for the cylinder, the wedge and the slab, whose
-//! walls keep their size: thesis L348-351, L361), and removes the overlaps within the attempt
+//! walls keep their size: [T000 §2.2.4]), and removes the overlaps within the attempt
 //! budget. On failure the saved state is restored and the step refined.
 //!
 //! * `Fixed` (the thesis): dV constant; after a failure dV /= 2; the run stops at the failure

@@ -3,7 +3,7 @@
 //!
 //! The contact follows the common-normal principle (thesis 000, ch. 3): the closest points of
 //! the two axis segments give k (from i's axis point to j's), the overlap
-//! delta = R_i + R_j - |k| (erratum E1: positive = overlap), the outward unit normal of i
+//! delta = R_i + R_j - |k| (erratum E-000-1: positive = overlap), the outward unit normal of i
 //! n = k / |k| (pointing into j), and i's contact point relative to its centre
 //! r_c = s u_i + R_i n.
 

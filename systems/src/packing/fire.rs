@@ -4,7 +4,7 @@
 //! length is capped by the particle's smallest overlap (eq. 3.9). Near jamming the network's
 //! relaxation time diverges and the attempt budget runs out early: with 200 N moves per step
 //! they stop at phi ~ 0.59-0.61 for monodisperse spheres (the thesis's own superball runs
-//! stopped at 0.61, L958). This scheme removes the same overlaps collectively: it minimises
+//! stopped at 0.61, [T000 §4.5]). This scheme removes the same overlaps collectively: it minimises
 //! U = sum_pairs delta^2 / 2 over all translations and rotations with FIRE (Bitzek, Koskinen,
 //! Gaehler, Moseler, Gumbsch, PRL 97, 170201, 2006), whose iteration count grows like the
 //! square root of the stiffness ratio instead of linearly. The compression driver, the

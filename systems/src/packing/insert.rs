@@ -4,7 +4,7 @@
 //! those where it would cross a wall) and
 //! orientations uniformly on the sphere (normalised Gaussian quaternion) from its own stream
 //! until it overlaps no earlier particle (thesis: "care is taken to ensure no initial
-//! particle-particle overlaps exist", L259).
+//! particle-particle overlaps exist", [T000 §2.2.1]).
 
 use glam::{DQuat, DVec3};
 use rand::RngExt;

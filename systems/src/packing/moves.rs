@@ -7,19 +7,19 @@
 //!   lambda = sqrt((F.F/m + T.I^-1 T) / (2c)),
 //! and the move x += delta_min dt v, rotation by |w| delta_min dt about w.
 //! Choices: n_ij is i's outward normal towards j (so v points away from j); c = 1, density 1,
-//! lengths in units of D (the thesis's units); erratum E4: w is a lab-frame vector, so the
+//! lengths in units of D (the thesis's units); erratum E-000-4: w is a lab-frame vector, so the
 //! rotation is applied on the left, q <- r(w) q (the printed R_t r is only right for a
-//! body-frame w); erratum E3 (c = 1/2, not 2, recovers eq. 2.6) does not matter here since only
+//! body-frame w); erratum E-000-3 (c = 1/2, not 2, recovers eq. 2.6) does not matter here since only
 //! dt sqrt(c) enters.
 //!
 //! **Original scheme** (Williams-Philipse, thesis ch. 2, eqs. 2.4-2.10). With the unnormalised
-//! separation vector k_sep = -k (from j's axis point to i's: erratum E2 fixes this direction),
+//! separation vector k_sep = -k (from j's axis point to i's: erratum E-000-2 fixes this direction),
 //! v = sum delta k_sep, and the axis rate w_a = (1/xi) sum delta l (k_sep.e_x) e_x + (...) e_y
 //! (equivalently the part of sum delta l k_sep normal to the axis, divided by xi), step
 //! dt_i = beta min_j delta_j / ((v + l_j w_a) . k_sep_j / |k_sep_j|) over contacts with a
 //! positive rate, x += dt_i v, e_z <- normalise(e_z + dt_i w_a). eq. 2.7's lambda = 1/2 is
 //! irrelevant since dt_i scales as 1/|rate|. xi defaults to I_xy of eq. 2.3 with m = 1
-//! (erratum E12). Particles whose contacts all have non-positive rates are not moved (E13).
+//! (erratum E-000-12). Particles whose contacts all have non-positive rates are not moved (E-000-13).
 //!
 //! The two random-direction variants of Fig. 3.4 (random w direction; random v and w
 //! directions, magnitudes kept) are provided for the overlap-decay study only.

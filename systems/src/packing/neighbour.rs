@@ -1,7 +1,7 @@
 //! Verlet neighbour list over all periodic images, built with a cell list.
 //!
 //! The list holds, for every particle i, the pairs (j, image shift) whose axis segments are
-//! closer than R_i + R_j + skin (the thesis's "modified Verlet list", L285, made exact with the
+//! closer than R_i + R_j + skin (the thesis's "modified Verlet list", [T000 §2.2.3], made exact with the
 //! segment distance). It stays valid while no pair can have approached by more than the skin:
 //! the bookkeeping adds each particle's end-point displacement bound |dx| + h |du| and, for an
 //! affine compression by s, (1 - s) times the largest centre range of a listed pair.

@@ -2,8 +2,8 @@
 //!
 //! One sweep: find every particle with an overlap above the tolerance, shuffle them, and move
 //! each in turn with its contacts recomputed at that moment (the thesis does not state the update
-//! order, E13; in-place sweeps in random order are the spec's recommendation). One "attempt" is
-//! one single-particle move (the thesis's try: ~200 N per compression step, L610). The run
+//! order, E-000-13; in-place sweeps in random order are the convention of D-000-19). One "attempt" is
+//! one single-particle move (the thesis's try: ~200 N per compression step, [T000 §3.2]). The run
 //! succeeds when no overlap above the tolerance remains, and fails when the attempt budget is
 //! spent first.
 

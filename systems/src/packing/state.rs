@@ -1,6 +1,6 @@
 //! Dense packing state in reduced units.
 //!
-//! The MCM's revised step size depends on the unit system (spec packing.md 5.2: a move is at
+//! The MCM's revised step size depends on the unit system (D-000-15 in docs/references.md: a move is at
 //! most delta_min * dt * sqrt(2c/m)), so the kernels work in the thesis's units: lengths in
 //! units of a reference diameter D (the smallest particle diameter of the scene, twice the
 //! smallest semi-axis for superquadrics), density 1 (mass = reduced volume), c = 1.
@@ -92,7 +92,7 @@ impl PackingState {
         walls::container_volume(self.walls, self.edges)
     }
 
-    /// Packing fraction (particle volume over container volume, spec eq. 3.1).
+    /// Packing fraction (particle volume over container volume, [T000 eq. 3.1]).
     pub fn packing_fraction(&self) -> f64 {
         self.particle_volume() / self.container_volume()
     }

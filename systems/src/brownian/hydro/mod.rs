@@ -1,9 +1,9 @@
 //! Hydrodynamic mobilities and correlated Brownian displacements for the Ermak–McCammon
-//! update (thesis: R. J. Baars 2016, ch. 6, eqs. 6.5–6.16; spec digest §2.2).
+//! update (thesis: R. J. Baars 2016, ch. 6, eqs. 6.5–6.16; D-000-9 in docs/references.md).
 //!
 //! # Equations
 //! x(t+h) = x + h μ(x) F + √(2 k_B T) B ΔW, ΔW ~ N(0, h I_{3N}), B Bᵀ = μ = D/k_BT.
-//! No divergence term: ∇·μ = 0 for RPY (thesis L1606).
+//! No divergence term: ∇·μ = 0 for RPY ([T000 §6.2.2]; erratum E-000-19).
 //!
 //! * [`MobilityMethod::FreeDraining`]: μ_ii = I/(6πηa_i), μ_ij = 0, B = μ^{1/2} (O(N)).
 //! * [`MobilityMethod::Cholesky`]: dense RPY μ ([`rpy`], Zuk et al. 2014 polydisperse blocks

@@ -22,7 +22,7 @@
 //!
 //! The full paper text was not reachable through the reference search (only the abstract
 //! and figure captions of arXiv:0801.3212 / JCP 130, 114905). The formulas above are the
-//! reconstruction of the spec digest (§2.2 of `magnetic-field-and-brownian.md`), re-derived
+//! reconstruction D-000-9 (docs/references.md), re-derived
 //! here from the uniform-coupling ansatz (see above) and checked numerically (diagonal
 //! variance exact; uniform-coupling matrix reproduced exactly). A public GPU code manual
 //! (SOP-GPU) prints β' = (1 − √(1−[(N−1)ε² − (N−2)ε]))/√((N−1)ε² − (N−2)ε), C_α with

@@ -90,7 +90,7 @@ fn tea_diagonal_exact_and_cross_correlation_error_small() {
     //   max |ΔC|/√DD  0.085  0.064  0.045   (normalised cross-covariance error)
     //   COM D_x err   5.3 %  4.1 %  3.1 %   (dimer centre-of-mass diffusion, ∥ axis)
     // triangle (2.5a, polydisperse) 0.089; 4-chain at 2.2a 0.096. For pairs TEA always
-    // underestimates the coupling, as the thesis (L1704) and Geyer & Winter state (in
+    // underestimates the coupling, as the thesis ([T000 §6.3]) and Geyer & Winter state (in
     // clusters some weak couplings come out slightly larger: checked for pairs only); the
     // "up to 5 %" figure matches the dimer centre-of-mass diffusion (their Table I quantity),
     // while single cross-covariance elements deviate by up to ~10 % of √(D_aa D_bb).

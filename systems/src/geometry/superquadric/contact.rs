@@ -1,6 +1,6 @@
 //! Public contact entry point: bounding spheres, GJK/EPA seeding (parry3d-f64 on the analytic
-//! support maps), the common-normal Newton polish and the acceptance tests (Alg. D of the
-//! spec, with the changes listed in the module header).
+//! support maps), the common-normal Newton polish and the acceptance tests ([T000 §4.4.1],
+//! with the changes listed in the module header).
 
 use glam::{DMat3, DQuat, DVec3};
 

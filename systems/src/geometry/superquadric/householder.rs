@@ -9,7 +9,7 @@
 //! t = e_j1 - beta m_j1 h,   b = e_j2 - beta m_j2 h
 //!
 //! are unit, orthogonal to each other and to m (for k = x, sigma = +1 this is eq. 4.32, whose
-//! factors h_x/h_x are 1: erratum E10). Derivatives (v any vector, j = j1 or j2):
+//! factors h_x/h_x are 1: erratum E-000-10). Derivatives (v any vector, j = j1 or j2):
 //!
 //! v^T dt/dm = beta^2 (v.h) m_j (2 m + sigma |m| e_k + |m_k| m^) - beta (v.h) e_j
 //!             - beta m_j (v + sigma v_k m^),

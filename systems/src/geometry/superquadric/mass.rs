@@ -20,13 +20,13 @@
 //! at unit density (eps G(3 eps/2) = (2/3) G(1 + 3/g)). Sphere: 4 pi/3 and 8 pi/15; cube of
 //! side 2a: 8 a^3 and 16 a^5/3.
 //!
-//! Circumscribed radius (App. 4.C). Erratum E7: eq. 4.35 says "minimize"; the radius is the
+//! Circumscribed radius (App. 4.C). Erratum E-000-7: eq. 4.35 says "minimize"; the radius is the
 //! *maximum* of |x| on the surface. With u_i = (x_i/a_i)^2 the problem is
 //! max sum a_i^2 u_i subject to sum u_i^(g_i/2) <= 1, a linear objective on a convex set.
 //! Equal exponents: Hoelder gives eq. 4.38, r^2 = || (a_i^2) ||_q with q = g/(g - 2), i.e.
 //! r^2 = (sum (a_i^2)^(1/(1-eps)))^(1-eps), evaluated after dividing by max a_i^2 so that the
 //! g = 2 singularity of eq. 4.38 (eps = 1) becomes the limit r = max a_i without overflow;
-//! superball eq. 4.39, r^2 = 3^(1-eps) a^2. Unequal exponents (no closed form, L1139): the
+//! superball eq. 4.39, r^2 = 3^(1-eps) a^2. Unequal exponents (no closed form, [T000 App. 4.C]): the
 //! Lagrange dual D(lambda) = lambda + sum_i sup_u (a_i^2 u - lambda u^(g_i/2)) is a convex
 //! function of one variable whose value at *any* lambda is an upper bound of r^2 (weak
 //! duality); it is minimised by bisection on its derivative 1 - sum u_i*(lambda)^(g_i/2), so the

@@ -1,4 +1,4 @@
-//! Starting points for the Newton solve (replacing the point-sampled surfaces of Alg. E):
+//! Starting points for the Newton solve (replacing the point-sampled surfaces of [T000 §4.4.2]):
 //! GJK (separated pairs: closest points) or EPA (penetrating pairs) of parry3d-f64 on the
 //! analytic support maps gives a direction n in a's frame; the seeds are the support points
 //! of a along n and of b along -n, which lie exactly on the surfaces with anti-parallel

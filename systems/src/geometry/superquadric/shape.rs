@@ -209,7 +209,7 @@ impl Superquadric {
         superquadric_inertia(self.semi_axes, self.exponents)
     }
 
-    /// Circumscribed (bounding) sphere radius about the centre (App. 4.C, erratum E7) [m].
+    /// Circumscribed (bounding) sphere radius about the centre (App. 4.C, erratum E-000-7) [m].
     ///
     /// ```
     /// use magsep_systems::geometry::superquadric::Superquadric;

@@ -1,4 +1,4 @@
-//! Statistical acceptance test (spec packing.md 14, item 5): on 10^4 random pairs the sign of
+//! Statistical acceptance test (target V-PK-5): on 10^4 random pairs the sign of
 //! the overlap agrees with a dense, independent sampling test and Newton rarely fails.
 //!
 //! Dense test: directions from a's centre that can reach b's bounding sphere (a cone) are

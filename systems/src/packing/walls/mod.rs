@@ -1,5 +1,5 @@
 //! Hard walls for the mechanical contraction method: container geometry, virtual particles
-//! and the deepest-point rule (thesis 000, ch. 2, L342-363, Alg. F; spec packing.md sec. 8).
+//! and the deepest-point rule ([T000 §2.2.4, Figs. 2.3-2.5]; E-000-11, D-000-19 in docs/references.md).
 //!
 //! # Container
 //!
@@ -16,30 +16,30 @@
 //!
 //! Conventions: cylinder `edges.x = edges.y = 2 R_cyl` (the radius is taken from the kind);
 //! wedge `edges.y = edges.x tan(alpha)` (the slope plane is taken from the kind, the volume
-//! from the edges, spec 9.1: 1/2 l_w h_w w_w). The signed distance of a point to a wall is
+//! from the edges, [T000 §2.2.4]: 1/2 l_w h_w w_w). The signed distance of a point to a wall is
 //! positive inside: `c - n.x` for a plane, `R_cyl - rho(x)` for the cylinder.
 //!
-//! # Virtual particles ([`virtual_rods`], thesis Alg. F)
+//! # Virtual particles ([`virtual_rods`], [T000 §2.2.4])
 //!
 //! A spherocylinder (radius R, half length h, axis u; a sphere has h = 0) with end points
-//! p^+- = x +- h u (erratum E8) penetrates a wall where an end cap does: distance(p) < R.
+//! p^+- = x +- h u (erratum E-000-8) penetrates a wall where an end cap does: distance(p) < R.
 //! For each penetrating end point a *virtual rod* identical to the particle is placed outside
-//! the wall, tangent to it at the foot of p (spec 8.2, 8.3, reconstructions E11 of
+//! the wall, tangent to it at the foot of p ([T000 §2.2.4], reconstructions E-000-11 of
 //! Figs. 2.4/2.5):
 //!
 //! * cylinder: centre (a + rho_hat (R_cyl + R), p_z), rho_hat = (p - a)_xy / |(p - a)_xy|,
-//!   axis z (L356);
+//!   axis z ([T000 Fig. 2.4]);
 //! * plane (n, c): centre p + (c - n.p + R) n (the foot point plus R n), axis in the plane:
-//!   wedge bottom x, back y, slope (cos a, sin a, 0) as in the thesis (L361); slab and box
+//!   wedge bottom x, back y, slope (cos a, sin a, 0) as in the thesis ([T000 §2.2.4]); slab and box
 //!   faces (not in the thesis): the projection of u onto the plane, normalised, or when u is
 //!   (numerically) normal to the face the next coordinate axis (x face: y, y face: z,
 //!   z face: x).
 //!
 //! The caller computes the contact of the particle with each virtual rod by the ordinary
 //! pair contact with `r = virtual.centre - x` (no periodic image: the walls are not periodic
-//! along their normals) and adds it to the particle's sums like any other contact (L353).
+//! along their normals) and adds it to the particle's sums like any other contact ([T000 §2.2.4]).
 //!
-//! *Exactness* (spec 14.6). Let p be the particle's deepest axis point with respect to the
+//! *Exactness* (target V-PK-6). Let p be the particle's deepest axis point with respect to the
 //! wall (for a plane the end point with the smallest distance; for the cylinder the end point
 //! with the largest rho: rho is convex along a segment, so its maximum is at an end). The
 //! virtual rod's axis lies on the plane offset by R outside the wall (cylinder: on the
@@ -54,7 +54,7 @@
 //! between its own depth and the deeper end's depth (both bounds are attained: a rod parallel
 //! to a plane gives both ends their own depth). This is inherent to any tangent virtual
 //! particle (moving along the axis towards the deeper end always gets closer); we keep the
-//! thesis's "one virtual particle per penetrating end point" (L353), which pushes a rod
+//! thesis's "one virtual particle per penetrating end point" ([T000 §2.2.4]), which pushes a rod
 //! lying on a wall out without a spurious torque, and document the bound.
 //!
 //! # Deepest-point rule for any convex particle ([`convex_wall_contacts`])

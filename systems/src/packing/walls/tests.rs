@@ -149,7 +149,7 @@ fn virtual_rods_follow_the_thesis_criteria_and_axes() {
     assert!((v[0].centre - DVec3::new(5.7, -0.5, 1.0)).length() < 1e-14); // (p_x, -R, p_z)
     assert_eq!((v[1].wall, v[1].axis), (WallId::WedgeBack, DVec3::Y));
     assert!((v[1].centre - DVec3::new(6.5, 0.2, 1.0)).length() < 1e-14); // (l_w + R, p_y, p_z)
-    // slope criterion p_y > p_x tan(a) - R / cos(a) (L361)
+    // slope criterion p_y > p_x tan(a) - R / cos(a) ([T000 §2.2.4])
     let mut rng = particle_stream(3, 1);
     for _ in 0..2000 {
         let p = random_centre(&mut rng, k, e);
@@ -162,7 +162,7 @@ fn virtual_rods_follow_the_thesis_criteria_and_axes() {
             assert!((r.axis - DVec3::new(alpha.cos(), alpha.sin(), 0.0)).length() < 1e-15);
         }
     }
-    // cylinder: thesis criterion p_x^2 + p_y^2 > (R_cyl - R)^2 in the axis frame (L353)
+    // cylinder: thesis criterion p_x^2 + p_y^2 > (R_cyl - R)^2 in the axis frame ([T000 §2.2.4])
     let (k, e) = (WallKind::Cylinder { radius: 1.2 }, cylinder_edges(1.2, 5.0));
     let mut rng = particle_stream(3, 2);
     for _ in 0..2000 {
@@ -430,7 +430,7 @@ fn admissible_agrees_with_penetration_and_insertion_is_uniform() {
 
 #[test]
 fn wedge_minimum_matches_the_spec_table() {
-    // spec packing.md 8.3, R = 1/2: (Lambda, [(l, phi) for alpha = 9, 15, 30, 45 deg])
+    // D-000-17, R = 1/2: (Lambda, [(l, phi) for alpha = 9, 15, 30, 45 deg])
     let table: [(f64, [(f64, f64); 4]); 5] = [
         (
             1.0,

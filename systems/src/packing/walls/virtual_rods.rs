@@ -1,4 +1,4 @@
-//! Virtual rods of a penetrating sphere or spherocylinder (thesis Alg. F; construction,
+//! Virtual rods of a penetrating sphere or spherocylinder ([T000 §2.2.4]; construction,
 //! exactness and the two-end bound in the parent module's header).
 
 use glam::DVec3;

@@ -1,4 +1,4 @@
-//! The smallest wedge (thesis 000, eqs. 2.12, 2.13, L423-433; spec packing.md 8.3).
+//! The smallest wedge ([T000 §2.4, eqs. 2.12, 2.13]; D-000-17 in docs/references.md).
 //!
 //! The smallest wedge holds one row of particles along the slope: the first cap inscribed in
 //! the vertex angle (its centre R / tan(alpha/2) from the vertex along the slope), the rod
@@ -6,7 +6,7 @@
 //!
 //! l_w,min = R / tan(alpha/2) + R + L cos(alpha)                          (2.12)
 //!
-//! (erratum E9: the seed prints "R/tan alpha/2", which is R / tan(alpha/2)). Its packing
+//! (erratum E-000-9: the thesis prints "R/tan alpha/2", which is R / tan(alpha/2)). Its packing
 //! fraction is that of one particle in a wedge of width 2R:
 //!
 //! phi_lw,min = pi R^2 (4/3 R + L) / (1/2 2R l_w,min^2 tan(alpha))        (2.13)
