@@ -31,6 +31,7 @@ pub fn typed<T: DeserializeOwned>(
             let full = match (path.is_empty(), inner.as_str()) {
                 (_, ".") => path.to_string(),
                 (true, i) => i.to_string(),
+                (false, i) if i.starts_with('[') => format!("{path}{i}"),
                 (false, i) => format!("{path}.{i}"),
             };
             let raw = e.into_inner().to_string();

@@ -40,13 +40,14 @@ pub fn spawn_scene_with(
             "a field-only scene has nothing to spawn".into(),
         ));
     };
-    pipeline.spawn(scene, world, seed)?;
     world.insert_resource(RunSeed(seed));
     world.insert_resource(Health::default());
     world.insert_resource(SceneText(scene.text.clone()));
     world.insert_resource(RecordEvery(
         scene.record.as_ref().map(|r| r.every).unwrap_or(100),
     ));
+    // the pipeline spawns after the common resources, so it may override them
+    pipeline.spawn(scene, world, seed)?;
     // fibres as entities, and the applied field
     let (sources, b_ext, tolerance) = scene.field_sources();
     for (i, s) in sources.iter().enumerate() {
