@@ -1,45 +1,32 @@
 //! A user force in the brownian pipeline: gravity and buoyancy on the nanoparticles
-//! (`F = (ρ_p − ρ_f) V g`, along −z), added by a plugin in `ForceSystems::Custom`.
+//! (`F = (ρ_p − ρ_f) V g`, along −z), as an external force kernel.
 //!
-//! The brownian integrator re-evaluates its built-in contributions (field, dipole, contact) at
-//! every adaptive sub-step and holds other registered contributions, like this one, fixed over
-//! the step. Run: `cargo run --release --example brownian_sedimentation`.
+//! The brownian stepper evaluates kernels at every adaptive sub-step, with the sub-step's
+//! positions, so the step controller sees them (a plain force component would be frozen over
+//! the step, and the pipeline refuses one under adaptive steps). Run:
+//! `cargo run --release --example brownian_sedimentation`.
 
-use bevy_ecs::prelude::*;
+use std::sync::Arc;
+
 use glam::DVec3;
-use magsep::plugins::brownian::brownian_pipeline;
 use magsep::prelude::*;
 use magsep::scene::parse_scene;
+use magsep::systems::forces::{ExternalForce, ParticleState};
 
-/// Gravity minus buoyancy [N].
-#[derive(Component, Debug, Default, Clone, Copy)]
-pub struct SedimentationForce(pub DVec3);
+/// Gravity minus buoyancy on a sphere: `(ρ_p − ρ_f) (4/3) π a³ g`, downwards [N].
+pub struct Sedimentation {
+    /// Density difference particle − fluid [kg/m³].
+    pub excess: f64,
+}
 
-impl ForceContribution for SedimentationForce {
-    fn force(&self) -> DVec3 {
-        self.0
-    }
-    fn clear(&mut self) {
-        self.0 = DVec3::ZERO;
+impl ExternalForce for Sedimentation {
+    fn force_torque(&self, p: &ParticleState) -> (DVec3, DVec3) {
+        let v = 4.0 / 3.0 * std::f64::consts::PI * p.shape.radius().powi(3);
+        (DVec3::new(0.0, 0.0, -self.excess * v * 9.81), DVec3::ZERO)
     }
 }
 
-/// Density difference particle − fluid [kg/m³].
-#[derive(Resource, Debug, Clone, Copy)]
-pub struct DensityExcess(pub f64);
-
-/// Forces::Custom: `(ρ_p − ρ_f) (4/3) π a³ g`, downwards.
-pub fn compute_sedimentation(
-    excess: Res<DensityExcess>,
-    mut q: Query<(&Shape, &mut SedimentationForce)>,
-) {
-    for (shape, mut f) in &mut q {
-        let v = 4.0 / 3.0 * std::f64::consts::PI * shape.radius().powi(3);
-        f.0 = DVec3::new(0.0, 0.0, -excess.0 * v * 9.81);
-    }
-}
-
-/// Adds the force to every particle and registers it.
+/// Registers the kernel.
 #[derive(Debug, Clone, Copy)]
 pub struct SedimentationPlugin {
     /// Density difference [kg/m³].
@@ -48,11 +35,12 @@ pub struct SedimentationPlugin {
 
 impl SimPlugin for SedimentationPlugin {
     fn build(&self, app: &mut SimApp) {
-        app.world.insert_resource(DensityExcess(self.excess));
-        app.insert_on_particles(SedimentationForce::default());
-        app.register_force::<SedimentationForce>();
-        app.schedule
-            .add_systems(compute_sedimentation.in_set(ForceSystems::Custom));
+        app.add_external_force(
+            "sedimentation",
+            Arc::new(Sedimentation {
+                excess: self.excess,
+            }),
+        );
     }
 }
 
@@ -74,14 +62,9 @@ placement = { kind = "box", min = [0.0, 0.0, 0.0], max = [1e-3, 1e-3, 1e-3] }
         &Default::default(),
     )?;
     // polystyrene-magnetite beads in water: ρ_p − ρ_f ≈ 1000 kg/m³ (5 g/cm³ cores are diluted)
-    let pipeline = brownian_pipeline().add(SedimentationPlugin { excess: 1000.0 });
-    let mut sim = Simulation::from_scene(
-        &scene,
-        RunOptions {
-            pipeline: Some(pipeline),
-            ..Default::default()
-        },
-    )?;
+    let mut sim = Simulation::builder(&scene)
+        .add_plugin(SedimentationPlugin { excess: 1000.0 })
+        .build()?;
     let z0: f64 = mean_z(&mut sim);
     sim.run(|_| {})?;
     let z1 = mean_z(&mut sim);
