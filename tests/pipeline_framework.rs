@@ -10,29 +10,11 @@ use magsep::replay::resume;
 use magsep::scene::parse_scene;
 use magsep_systems::sets::SimSystems;
 
-const BROWNIAN: &str = r#"
-[simulation]
-pipeline = "brownian"
-seed = 5
-[external_field]
-flux_density = [1.0, 0.0, 0.0]
-[[fibres]]
-kind = "cylinder"
-radius = 300e-6
-half_length = 6e-3
-axis = [1.0, 0.0, 0.0]
-saturation_magnetisation = 985e3
-[brownian]
-time_step = 5e-5
-duration = 0.005
-[[particles]]
-count = 4
-shape = { kind = "sphere", radius = 125e-9 }
-moment = { kind = "saturated", moment = 5.151e-16 }
-placement = { kind = "fibre_top", fibre = 0, gap = 1e-6, height = 20e-6 }
-[record]
-every = 30
-"#;
+/// A short brownian scene (4 particles, 100 steps, a frame every 30 steps), also read by
+/// the Python reader check of CI.
+fn brownian() -> String {
+    std::fs::read_to_string("tests/data/brownian_short.toml").unwrap()
+}
 
 fn tmp(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("magsep-framework-{}", std::process::id()));
@@ -42,7 +24,7 @@ fn tmp(name: &str) -> std::path::PathBuf {
 
 #[test]
 fn an_unknown_pipeline_is_an_error_naming_the_registered_ones() {
-    let text = BROWNIAN.replace("pipeline = \"brownian\"", "pipeline = \"brownain\"");
+    let text = brownian().replace("pipeline = \"brownian\"", "pipeline = \"brownain\"");
     let e = parse_scene(&text, &Default::default()).unwrap_err();
     let err =
         e.0.iter()
@@ -56,7 +38,10 @@ fn an_unknown_pipeline_is_an_error_naming_the_registered_ones() {
 
 #[test]
 fn sections_and_particle_keys_of_other_pipelines_are_errors_naming_their_pipeline() {
-    let text = format!("{BROWNIAN}\n[packing]\nscheme = \"fire\"\n[liquid]\ndensity = 1000.0\n");
+    let text = format!(
+        "{}\n[packing]\nscheme = \"fire\"\n[liquid]\ndensity = 1000.0\n",
+        brownian()
+    );
     let text = text.replace("count = 4\n", "count = 4\ndensity = 1200.0\nwhatever = 1\n");
     let e = parse_scene(&text, &Default::default()).unwrap_err().0;
     let at = |p: &str| e.iter().find(|x| x.path == p).map(|x| x.message.clone());
@@ -128,7 +113,7 @@ impl SimPlugin for CountPlugin {
 
 #[test]
 fn builder_plugins_act_and_add_summary_keys() {
-    let scene = parse_scene(BROWNIAN, &Default::default()).unwrap();
+    let scene = parse_scene(&brownian(), &Default::default()).unwrap();
     let summary = Simulation::builder(&scene)
         .add_plugin(CountPlugin)
         .build()
@@ -141,7 +126,7 @@ fn builder_plugins_act_and_add_summary_keys() {
 
 #[test]
 fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
-    let scene = parse_scene(BROWNIAN, &Default::default()).unwrap();
+    let scene = parse_scene(&brownian(), &Default::default()).unwrap();
     let path = tmp("with_plugin.mcap");
     let mut sim = Simulation::builder(&scene)
         .add_plugin(CountPlugin)
