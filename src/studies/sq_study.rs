@@ -14,8 +14,8 @@
 //! Times come from `std::time::Instant` over many calls (a benchmark, not a unit test).
 //!
 //! ```no_run
-//! let r = magsep::sq_study::run_sq_contact_study(true);
-//! let summary = magsep::sq_study::write_sq_study(&r, "out".as_ref()).unwrap();
+//! let r = magsep::studies::sq_study::run_sq_contact_study(true);
+//! let summary = magsep::studies::sq_study::write_sq_study(&r, "out".as_ref()).unwrap();
 //! println!("{summary}");
 //! ```
 
@@ -103,7 +103,7 @@ impl StudyResult {
     /// The data as JSON (a machine summary).
     ///
     /// ```
-    /// let r = magsep::sq_study::StudyResult { quick: true, exponents: vec![], accuracy: vec![] };
+    /// let r = magsep::studies::sq_study::StudyResult { quick: true, exponents: vec![], accuracy: vec![] };
     /// assert_eq!(r.to_json()["quick"], true);
     /// ```
     pub fn to_json(&self) -> Value {
@@ -400,7 +400,7 @@ fn accuracy_points(pairs: usize, timed: usize, min_time: f64) -> Vec<AccuracyPoi
 /// minute in release).
 ///
 /// ```no_run
-/// let r = magsep::sq_study::run_sq_contact_study(true);
+/// let r = magsep::studies::sq_study::run_sq_contact_study(true);
 /// assert!(r.exponents.iter().all(|p| p.failure_rate < 1e-2));
 /// ```
 pub fn run_sq_contact_study(quick: bool) -> StudyResult {
@@ -460,7 +460,7 @@ fn family_series(
 /// The two charts as SVG documents: (convergence and cost against g, accuracy against cost).
 ///
 /// ```
-/// use magsep::sq_study::{StudyResult, render_sq_study_charts};
+/// use magsep::studies::sq_study::{StudyResult, render_sq_study_charts};
 /// let r = StudyResult { quick: true, exponents: vec![], accuracy: vec![] };
 /// let (a, b) = render_sq_study_charts(&r);
 /// assert!(a.starts_with("<svg") && b.ends_with("</svg>\n"));
@@ -552,7 +552,7 @@ pub fn render_sq_study_charts(r: &StudyResult) -> (String, String) {
 /// Any I/O error from creating `out` or writing the files.
 ///
 /// ```no_run
-/// use magsep::sq_study::{run_sq_contact_study, write_sq_study};
+/// use magsep::studies::sq_study::{run_sq_contact_study, write_sq_study};
 /// let summary = write_sq_study(&run_sq_contact_study(true), "target/sq".as_ref()).unwrap();
 /// assert!(summary["charts"].is_array());
 /// ```

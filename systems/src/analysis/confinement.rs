@@ -109,7 +109,8 @@ impl LinearFit {
     /// ```
     /// use magsep_systems::analysis::confinement::fit_line;
     /// let f = fit_line(&[1.0, 2.0, 3.0, 4.0, 5.0], &[1.0, 3.0, 2.0, 5.0, 4.0]).unwrap();
-    /// assert!((f.intercept_half_width_95() - 3.1824 * 1.32f64.sqrt()).abs() < 1e-12);
+    /// // t_{0.975, 3} = 3.182446305284263 (exact Student-t quantile)
+    /// assert!((f.intercept_half_width_95() - 3.182446305284263 * 1.32f64.sqrt()).abs() < 1e-9);
     /// ```
     pub fn intercept_half_width_95(&self) -> f64 {
         student_t_95(self.n - 2) * self.intercept_stderr
