@@ -9,6 +9,8 @@
 3. Shared code names no pipeline: the driver, scene parser, replay, CLI and recorder hold no
    string literal "packing", "brownian" or "particle_fluid" and import no pipeline module
    (comments, doc examples and #[cfg(test)] modules aside).
+4. Every repository path a document names in backquotes (`src/...`, `tests/...`, `docs/...`,
+   and the other top-level folders) exists, so README.md and docs/ do not point at moved files.
 
 Exit 1 with every finding listed, 0 when clean.
 """
@@ -138,6 +140,27 @@ def pipeline_names_in_shared_code():
     return found
 
 
+TOP_DIRS = ("src/", "systems/", "plugins/", "components/", "record/", "tests/", "scripts/",
+            "examples/", "scenes/", "docs/", ".ci/")
+
+
+def stale_doc_paths():
+    found = []
+    docs = [os.path.join(ROOT, "README.md")]
+    for d, dirs, files in os.walk(ROOT):
+        dirs[:] = [x for x in dirs if x not in ("target", ".git")]
+        docs += [os.path.join(d, f) for f in files if f.endswith(".md")]
+    for f in sorted(set(docs)):
+        text = open(f, encoding="utf-8").read()
+        for m in re.finditer(r"`([A-Za-z0-9_./-]+)`", text):
+            p = m.group(1)
+            if not p.startswith(TOP_DIRS) or "*" in p:
+                continue
+            if not os.path.exists(os.path.join(ROOT, p.rstrip("/"))):
+                found.append(f"{os.path.relpath(f, ROOT)}: names `{p}`, which does not exist")
+    return found
+
+
 def main():
     problems = []
     cycles, graph = import_cycles()
@@ -145,6 +168,7 @@ def main():
         problems.append("import cycle between top-level modules: " + " <-> ".join(c))
     problems += long_files()
     problems += pipeline_names_in_shared_code()
+    problems += stale_doc_paths()
     print(f"modules: {len(graph)}; edges: {sum(len(v) for v in graph.values())}")
     if "-v" in sys.argv:
         for m in sorted(graph):
@@ -154,7 +178,8 @@ def main():
     if problems:
         print(f"{len(problems)} structural problem(s)")
         return 1
-    print("structure ok: no import cycles, no file over 600 lines, no pipeline name in shared code")
+    print("structure ok: no import cycles, no file over 600 lines, no pipeline name in shared code, "
+          "no stale path in the documents")
     return 0
 
 

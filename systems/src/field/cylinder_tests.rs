@@ -1,5 +1,5 @@
 //! Tests of the body-frame kernel: golden values (D-000-2 in docs/references.md, 40-digit mpmath), identities and
-//! limits. Comparisons with independent quadrature are in `tests/field_reference.rs`.
+//! limits. Comparisons with independent quadrature are in `tests/it/field_reference.rs`.
 
 use super::*;
 use crate::field::real::Dual3;

@@ -92,7 +92,7 @@ fn full_tier_long_rods_random_contact_equation() {
 #[test]
 #[ignore = "validation tier (release): phi against aspect ratio, N = 200, 2 seeds"]
 fn packing_fraction_is_non_monotonic_in_aspect_ratio_with_a_maximum_at_small_elongation() {
-    let ratios = [1.0, 1.2, 1.4, 1.6, 2.0, 3.0, 5.0];
+    let ratios = [1.0, 1.3, 1.6, 2.0, 5.0];
     let phi: Vec<f64> = ratios
         .iter()
         .map(|&l| {
@@ -116,7 +116,7 @@ fn packing_fraction_is_non_monotonic_in_aspect_ratio_with_a_maximum_at_small_elo
         ratios[imax]
     );
     assert!(phi[imax] > phi[0] + 0.02, "rise above spheres: {phi:?}");
-    assert!(phi[6] < phi[imax] - 0.05, "decay at aspect 5: {phi:?}");
+    assert!(phi[4] < phi[imax] - 0.05, "decay at aspect 5: {phi:?}");
 }
 
 #[test]

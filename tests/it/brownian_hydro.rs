@@ -8,7 +8,7 @@ use magsep::plugins::brownian::brownian_pipeline;
 use magsep::prelude::*;
 use magsep::scene::parse_scene;
 
-mod common;
+use crate::common;
 use common::sorted_positions;
 
 #[derive(Component, Debug, Default, Clone, Copy)]

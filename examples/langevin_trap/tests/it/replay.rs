@@ -1,7 +1,7 @@
 //! Replay and resume: the summary recomputed from a recording's frames equals the run's, and
 //! a run resumed from a recorded frame ends as the uninterrupted run.
 
-mod common;
+use crate::common;
 
 use common::{parse, run, temp_dir, trap_scene, without_wall_time};
 use langevin_trap::registry;

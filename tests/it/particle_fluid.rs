@@ -1,7 +1,7 @@
 //! The particle-fluid pipeline end to end: scenes, the ECS path against the single-sphere
 //! kernel, closed forms through the summary, validation errors, replay and determinism.
 
-mod common;
+use crate::common;
 
 use magsep::prelude::*;
 use magsep::scene::{Scene, parse_scene};

@@ -1,7 +1,7 @@
 //! The `langevin-trap` binary: `run --record`, `validate`, `info --json`, `replay`, and the
 //! same summary on one thread or two.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Output};

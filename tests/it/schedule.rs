@@ -8,13 +8,13 @@ use magsep::scene::parse_scene;
 use magsep::systems::forces::ForceRegistry;
 use magsep::systems::sets::new_sim_schedule;
 
-#[path = "../examples/custom_force.rs"]
+#[path = "../../examples/custom_force.rs"]
 #[allow(dead_code)]
 mod custom_force;
-#[path = "../examples/custom_schedule.rs"]
+#[path = "../../examples/custom_schedule.rs"]
 #[allow(dead_code)]
 mod custom_schedule;
-#[path = "../examples/replace_plugin.rs"]
+#[path = "../../examples/replace_plugin.rs"]
 #[allow(dead_code)]
 mod replace_plugin;
 

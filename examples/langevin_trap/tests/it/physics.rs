@@ -2,7 +2,7 @@
 //! is k_B T / k, the mean relaxes as e^{-t k/γ}, and a seed gives the same numbers on one
 //! thread or several.
 
-mod common;
+use crate::common;
 
 use common::{parse, run, trap_scene, without_wall_time};
 use langevin_trap::TrapConfig;

@@ -1,7 +1,7 @@
 //! Validation of `[trap]` and `start`: every error at its innermost key path, unknown keys,
 //! and the keys of this pipeline in another pipeline's scene.
 
-mod common;
+use crate::common;
 
 use common::{parse, trap_scene};
 use langevin_trap::{TrapScene, registry};

@@ -4,7 +4,7 @@
 use magsep::prelude::*;
 use magsep::scene::{Scene, parse_scene};
 
-mod common;
+use crate::common;
 use common::sorted_positions as positions;
 
 fn scene(text: &str) -> Scene {

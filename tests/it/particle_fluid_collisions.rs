@@ -2,7 +2,7 @@
 //! history reset, determinism across thread counts, and the many-particle separation runs
 //! (reduced; the thesis-size runs are `magsep chart separation`).
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use magsep::prelude::*;

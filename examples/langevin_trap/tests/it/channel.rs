@@ -1,7 +1,7 @@
 //! The recording channel `/langevin_trap/energy`: one message per frame, at the frame's step
 //! and log time, with the frame's ensemble averages, decodable with the embedded schema.
 
-mod common;
+use crate::common;
 
 use common::{parse, run, temp_dir, trap_scene};
 use langevin_trap::channel::{energy_message, energy_schema, log_time};

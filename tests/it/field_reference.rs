@@ -18,7 +18,7 @@ struct Row {
 }
 
 fn rows() -> Vec<Row> {
-    let text = include_str!("data/cylinder_field_reference.csv");
+    let text = include_str!("../data/cylinder_field_reference.csv");
     let mut lines = text.lines();
     let header = lines.next().expect("header");
     assert_eq!(

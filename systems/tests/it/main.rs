@@ -1,0 +1,6 @@
+//! Integration tests, one binary: every module below was a test file of its own. One
+//! binary links the crate once, which keeps CI's build time and disk use down.
+
+mod brownian_kernel_threads;
+mod field;
+mod overlap_decay;

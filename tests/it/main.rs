@@ -1,0 +1,19 @@
+//! Integration tests, one binary: every module below was a test file of its own. One
+//! binary links the crate once, which keeps CI's build time and disk use down.
+
+mod bench_brownian;
+mod brownian_capture;
+mod brownian_hydro;
+mod brownian_pipeline;
+mod brownian_replay;
+mod cli;
+mod cli_field;
+mod common;
+mod field_reference;
+mod fluid_charts;
+mod packing_validation;
+mod packing_walls;
+mod particle_fluid;
+mod particle_fluid_collisions;
+mod pipeline_framework;
+mod schedule;
