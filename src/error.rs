@@ -14,14 +14,80 @@ pub struct SceneError {
     pub message: String,
 }
 
+/// Longest message kept in full \[characters\]; a longer one (e.g. echoing a huge string
+/// value) is cut in the middle.
+pub const MAX_MESSAGE_CHARS: usize = 1000;
+
 impl SceneError {
-    /// A new error at `path`.
+    /// A new error at `path`. Long numbers (`1e300` printed by `{}` has 301 digits) are
+    /// rewritten in scientific notation, and a message longer than
+    /// [`MAX_MESSAGE_CHARS`] is cut, so no value floods the terminal.
     pub fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
         Self {
-            path: path.into(),
-            message: message.into(),
+            path: cut(&path.into(), MAX_MESSAGE_CHARS / 2),
+            message: cut(&compact_numbers(&message.into()), MAX_MESSAGE_CHARS),
         }
     }
+}
+
+/// `text` with every decimal number of more than 20 digits (or 12 with a decimal point) in
+/// scientific notation; 64-bit integers stay exact.
+pub fn compact_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let b = text.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        let starts_number = b[i].is_ascii_digit() && (i == 0 || !is_word(b[i - 1]));
+        if !starts_number {
+            let c = text[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+            continue;
+        }
+        let mut j = i;
+        let mut digits = 0;
+        let mut dot = false;
+        while j < b.len() && (b[j].is_ascii_digit() || (b[j] == b'.' && !dot)) {
+            if b[j] == b'.' {
+                // a dot followed by no digit ends the sentence, not the number
+                if !b.get(j + 1).is_some_and(u8::is_ascii_digit) {
+                    break;
+                }
+                dot = true;
+            } else {
+                digits += 1;
+            }
+            j += 1;
+        }
+        let number = &text[i..j];
+        let followed_by_word = j < b.len() && is_word(b[j]);
+        match number.parse::<f64>() {
+            Ok(v) if (digits > 20 || (dot && digits > 12)) && !followed_by_word => {
+                out.push_str(&format!("{v:e}"))
+            }
+            _ => out.push_str(number),
+        }
+        i = j;
+    }
+    out
+}
+
+fn is_word(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_'
+}
+
+/// `text` cut to about `max` characters, with the number of characters left out.
+fn cut(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        return text.to_string();
+    }
+    let head: String = text.chars().take(max * 3 / 4).collect();
+    let tail: String = text.chars().skip(n - max / 4).collect();
+    format!(
+        "{head} [... {} characters cut ...] {tail}",
+        n - max * 3 / 4 - max / 4
+    )
 }
 
 impl fmt::Display for SceneError {
@@ -47,6 +113,43 @@ impl fmt::Display for SceneErrors {
 }
 
 impl std::error::Error for SceneErrors {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_numbers_become_scientific_and_short_ones_stay() {
+        let huge = format!("got {}", 1e300);
+        assert_eq!(compact_numbers(&huge), "got 1e300");
+        assert_eq!(compact_numbers("got 0.000000000000001."), "got 1e-15.");
+        assert_eq!(
+            compact_numbers("in (0, 0.3], got 12.5"),
+            "in (0, 0.3], got 12.5"
+        );
+        assert_eq!(compact_numbers("particles[12].x"), "particles[12].x");
+        // digits inside a word (a hash, a name) are left alone
+        assert_eq!(
+            compact_numbers("id a12345678901234567"),
+            "id a12345678901234567"
+        );
+    }
+
+    #[test]
+    fn a_huge_value_is_cut_and_the_cut_is_counted() {
+        let e = SceneError::new(
+            "a.b",
+            format!("unknown value \"{}\"", "x".repeat(10_000_000)),
+        );
+        assert!(
+            e.message.len() < MAX_MESSAGE_CHARS + 80,
+            "{}",
+            e.message.len()
+        );
+        assert!(e.message.contains("characters cut"));
+        assert!(e.message.starts_with("unknown value \"xxx"));
+    }
+}
 
 /// Why spawning failed (after validation only run-time failures remain).
 #[derive(Debug, thiserror::Error)]

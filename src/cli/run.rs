@@ -91,7 +91,9 @@ pub fn run(
             .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
     let summary = run_scene(&scene, &options, &Bar(bar.clone())).map_err(|e| match e {
-        SimError::NothingToRun => CliError::input(e.to_string()),
+        // a scene that validates but cannot be spawned (a start region too small for its
+        // particles, a start box inside a fibre) is bad input too
+        SimError::NothingToRun | SimError::Spawn(_) => CliError::input(e.to_string()),
         e => CliError::runtime(e.to_string()),
     })?;
     bar.finish_and_clear();

@@ -20,6 +20,7 @@ use magsep_systems::field::{CylinderSource, EXACT, demag::stoner_wohlfarth_magne
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
+use super::checks::{LENGTH_RANGE, num, within};
 
 /// `[external_field]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -93,9 +94,10 @@ impl ExternalFieldSection {
     }
 }
 
-fn finite3(v: &[f64; 3]) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
+/// Largest external flux density component accepted \[T\].
+pub const MAX_FLUX_DENSITY: f64 = 100.0;
+/// Largest fibre magnetisation accepted \[A/m\] (iron saturates at 1.7e6 A/m).
+pub const MAX_MAGNETISATION: f64 = 1e7;
 
 /// Semantic checks of the fibres and the external field.
 pub fn validate_fibres(
@@ -104,11 +106,16 @@ pub fn validate_fibres(
     errors: &mut Vec<SceneError>,
 ) {
     if let Some(e) = external {
-        if !finite3(&e.flux_density) {
-            errors.push(SceneError::new(
-                "external_field.flux_density",
-                format!("must be three finite numbers [T], got {:?}", e.flux_density),
-            ));
+        for (k, b) in e.flux_density.iter().enumerate() {
+            let path = format!("external_field.flux_density[{k}]");
+            within(
+                errors,
+                &path,
+                *b,
+                -MAX_FLUX_DENSITY,
+                MAX_FLUX_DENSITY,
+                "[T]",
+            );
         }
         if let Some(t) = e.field_tolerance
             && !(t.is_finite() && (1e-15..=0.1).contains(&t))
@@ -130,18 +137,18 @@ pub fn validate_fibres(
             saturation_magnetisation,
         } = f;
         for (key, v) in [("radius", radius), ("half_length", half_length)] {
-            if !(v.is_finite() && *v > 0.0) {
-                errors.push(SceneError::new(
-                    format!("{p}.{key}"),
-                    format!("must be a finite number > 0 [m], got {v}"),
-                ));
-            }
+            within(
+                errors,
+                &format!("{p}.{key}"),
+                *v,
+                LENGTH_RANGE.0,
+                LENGTH_RANGE.1,
+                "[m]",
+            );
         }
-        if !finite3(center) {
-            errors.push(SceneError::new(
-                format!("{p}.center"),
-                format!("must be three finite numbers [m], got {center:?}"),
-            ));
+        for (k, c) in center.iter().enumerate() {
+            let (path, hi) = (format!("{p}.center[{k}]"), LENGTH_RANGE.1);
+            within(errors, &path, *c, -hi, hi, "[m]");
         }
         let a = DVec3::from_array(*axis);
         if !(a.is_finite() && a.length() > 0.0) {
@@ -159,14 +166,22 @@ pub fn validate_fibres(
                 format!("{p}.magnetisation"),
                 "missing: give magnetisation [A/m] (a vector) or saturation_magnetisation [A/m]",
             )),
-            (Some(m), None) if !finite3(m) => errors.push(SceneError::new(
-                format!("{p}.magnetisation"),
-                format!("must be three finite numbers [A/m], got {m:?}"),
-            )),
-            (None, Some(ms)) if !(ms.is_finite() && *ms > 0.0) => errors.push(SceneError::new(
-                format!("{p}.saturation_magnetisation"),
-                format!("must be a finite number > 0 [A/m], got {ms}"),
-            )),
+            (Some(m), None) if !m.iter().all(|c| c.abs() <= MAX_MAGNETISATION) => {
+                errors.push(SceneError::new(
+                    format!("{p}.magnetisation"),
+                    format!(
+                        "must be three numbers in [-{}, {}] [A/m], got {m:?}",
+                        num(MAX_MAGNETISATION),
+                        num(MAX_MAGNETISATION)
+                    ),
+                ))
+            }
+            (None, Some(ms)) if !(ms.is_finite() && *ms > 0.0 && *ms <= MAX_MAGNETISATION) => {
+                errors.push(SceneError::new(
+                    format!("{p}.saturation_magnetisation"),
+                    format!("must be in (0, {}] [A/m], got {ms}", num(MAX_MAGNETISATION)),
+                ))
+            }
             (None, Some(_)) if external.is_none_or(|e| e.flux_density == [0.0; 3]) => {
                 errors.push(SceneError::new(
                     format!("{p}.saturation_magnetisation"),

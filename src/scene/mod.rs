@@ -20,7 +20,7 @@ pub mod checks;
 mod fibre_packing;
 mod fibres;
 pub mod pipeline;
-mod placement;
+pub mod placement;
 mod sections;
 mod spawn;
 #[cfg(test)]

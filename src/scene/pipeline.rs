@@ -25,6 +25,9 @@ use crate::error::{ReplayError, SimError};
 
 /// What a pipeline's [`Pipeline::parse`] sees: the scene's TOML table, the common parts
 /// already typed, and the error list to push to (every error at its key path).
+///
+/// Section types are `Serialize` as well as `Deserialize`: the typed value is serialized
+/// back to find keys serde skipped without an error (see [`typed`]).
 pub struct ParseContext<'a> {
     /// The whole scene table (the pipeline reads its own keys, see [`Pipeline::sections`]).
     pub table: &'a toml::Table,
@@ -39,14 +42,20 @@ pub struct ParseContext<'a> {
 impl ParseContext<'_> {
     /// The top-level table `key` typed as `T` (`None` if absent or invalid; invalid values
     /// push errors with their inner key path).
-    pub fn section<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Option<T> {
+    pub fn section<T: serde::de::DeserializeOwned + serde::Serialize>(
+        &mut self,
+        key: &str,
+    ) -> Option<T> {
         self.table
             .get(key)
             .and_then(|v| typed::<T>(v, key, self.errors))
     }
 
     /// The top-level array of tables `key` (`[[key]]`), each entry typed with its index.
-    pub fn array<T: serde::de::DeserializeOwned>(&mut self, key: &str) -> Vec<(usize, T)> {
+    pub fn array<T: serde::de::DeserializeOwned + serde::Serialize>(
+        &mut self,
+        key: &str,
+    ) -> Vec<(usize, T)> {
         self.table
             .get(key)
             .map(|v| typed_array::<T>(v, key, self.errors))
@@ -54,7 +63,7 @@ impl ParseContext<'_> {
     }
 
     /// A required top-level table: an error if it is missing.
-    pub fn required<T: serde::de::DeserializeOwned>(
+    pub fn required<T: serde::de::DeserializeOwned + serde::Serialize>(
         &mut self,
         key: &str,
         pipeline: &str,

@@ -112,3 +112,28 @@ impl DensityRatios {
         }
     }
 }
+
+/// The first pair (i < j, by j then i) of explicit centres closer than `2 radius` \[m\]: two
+/// spheres that would start overlapping. A sweep along x after sorting, O(n log n) for
+/// spread points.
+pub fn first_overlap(positions: &[[f64; 3]], radius: f64) -> Option<(usize, usize)> {
+    let reach = 2.0 * radius;
+    let mut order: Vec<usize> = (0..positions.len()).collect();
+    order.sort_by(|&a, &b| positions[a][0].total_cmp(&positions[b][0]));
+    let mut found: Option<(usize, usize)> = None;
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            let d = DVec3::from_array(positions[b]) - DVec3::from_array(positions[a]);
+            if d.x > reach {
+                break;
+            }
+            if d.length() < reach {
+                let pair = (a.min(b), a.max(b));
+                if found.is_none_or(|f| (pair.1, pair.0) < (f.1, f.0)) {
+                    found = Some(pair);
+                }
+            }
+        }
+    }
+    found
+}

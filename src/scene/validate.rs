@@ -58,18 +58,170 @@ fn only_for(owners: &[&str]) -> String {
     format!("only for {}", names.join(" or "))
 }
 
+/// The checks of one shape (`p` is `particles[i]`): lengths in [`LENGTH_RANGE`], exponents
+/// in range, and the particle's own size ratio at most [`MAX_SIZE_RATIO`].
+fn shape_checks(p: &str, shape: &ShapeSpec, errors: &mut Vec<SceneError>) {
+    let (lo, hi) = LENGTH_RANGE;
+    let length = |errors: &mut Vec<SceneError>, key: &str, v: f64| {
+        within(errors, &format!("{p}.shape.{key}"), v, lo, hi, "[m]")
+    };
+    let ratio = |errors: &mut Vec<SceneError>, key: &str, big: f64, small: f64| {
+        check(
+            errors,
+            (big / small).is_nan() || big / small <= MAX_SIZE_RATIO,
+            &format!("{p}.shape.{key}"),
+            || {
+                format!(
+                    "makes the particle {} times longer than wide; at most {MAX_SIZE_RATIO}",
+                    num(big / small)
+                )
+            },
+        )
+    };
+    match *shape {
+        ShapeSpec::Sphere { radius } => length(errors, "radius", radius),
+        ShapeSpec::Superquadric {
+            semi_axes,
+            exponents,
+        } => {
+            for (k, a) in semi_axes.iter().enumerate() {
+                length(errors, &format!("semi_axes[{k}]"), *a);
+            }
+            for (k, g) in exponents.iter().enumerate() {
+                exponent_in_range(errors, &format!("{p}.shape.exponents[{k}]"), *g);
+            }
+            let (big, small) = min_max(&semi_axes);
+            ratio(errors, "semi_axes", big, small);
+        }
+        ShapeSpec::Superball {
+            semi_axis,
+            exponent,
+        } => {
+            length(errors, "semi_axis", semi_axis);
+            exponent_in_range(errors, &format!("{p}.shape.exponent"), exponent);
+        }
+        ShapeSpec::Ellipsoid { semi_axes } => {
+            for (k, a) in semi_axes.iter().enumerate() {
+                length(errors, &format!("semi_axes[{k}]"), *a);
+            }
+            let (big, small) = min_max(&semi_axes);
+            ratio(errors, "semi_axes", big, small);
+        }
+        ShapeSpec::Spherocylinder {
+            radius,
+            cylinder_length,
+        } => {
+            length(errors, "radius", radius);
+            within(
+                errors,
+                &format!("{p}.shape.cylinder_length"),
+                cylinder_length,
+                0.0,
+                hi,
+                "[m]",
+            );
+            ratio(
+                errors,
+                "cylinder_length",
+                cylinder_length + 2.0 * radius,
+                2.0 * radius,
+            );
+        }
+    }
+}
+
+fn min_max(v: &[f64; 3]) -> (f64, f64) {
+    (
+        v.iter().copied().fold(f64::MIN, f64::max),
+        v.iter().copied().fold(f64::MAX, f64::min),
+    )
+}
+
+/// The largest particle of the scene at most [`MAX_SIZE_RATIO`] times the smallest (the
+/// error names the smallest group).
+fn size_ratio_check(particles: &[(usize, ParticleGroup)], errors: &mut Vec<SceneError>) {
+    let sizes: Vec<(usize, f64)> = particles
+        .iter()
+        .map(|(i, g)| (*i, g.shape.shape().radius()))
+        .filter(|(_, r)| r.is_finite() && *r > 0.0)
+        .collect();
+    let big = sizes.iter().map(|s| s.1).fold(0.0, f64::max);
+    if let Some(&(i, small)) = sizes.iter().min_by(|a, b| a.1.total_cmp(&b.1))
+        && big / small > MAX_SIZE_RATIO
+    {
+        errors.push(SceneError::new(
+            format!("particles[{i}].shape"),
+            format!(
+                "is {} times smaller than the largest particle (bounding radius {} m); \
+                 at most {MAX_SIZE_RATIO}",
+                num(big / small),
+                num(big)
+            ),
+        ));
+    }
+}
+
+/// The key path of the `key = value` line holding byte `offset` of `text`: the last table
+/// header above it (`[a.b]`, `[[a]]` counted) joined with the line's key. `None` where the
+/// line is no key-value pair (a broken header, a multi-line value).
+fn key_at(text: &str, offset: usize) -> Option<String> {
+    let start = text[..offset.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
+    let line = text[start..].lines().next().unwrap_or("");
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim();
+    let bare = |k: &str| {
+        !k.is_empty()
+            && k.split('.').all(|p| {
+                !p.trim().is_empty()
+                    && p.trim()
+                        .chars()
+                        .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+            })
+    };
+    if !bare(key) {
+        return None;
+    }
+    let mut table = String::new();
+    let mut counts: std::collections::HashMap<String, usize> = Default::default();
+    for l in text[..start].lines() {
+        let l = l.trim();
+        if let Some(name) = l.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
+            let name = name.trim().to_string();
+            let n = counts.entry(name.clone()).or_insert(0);
+            table = format!("{name}[{n}]");
+            *n += 1;
+        } else if let Some(name) = l.strip_prefix('[').and_then(|r| r.split(']').next()) {
+            table = name.trim().to_string();
+        }
+    }
+    let key: Vec<&str> = key.split('.').map(str::trim).collect();
+    let key = key.join(".");
+    Some(if table.is_empty() {
+        key
+    } else {
+        format!("{table}.{key}")
+    })
+}
+
 /// The whole pipeline of checks.
 pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<SceneError>> {
     let table: toml::Table = match text.parse() {
         Ok(t) => t,
         Err(e) => {
             let e: toml::de::Error = e;
-            let at = e.span().map(|s| line_col(text, s.start));
+            let at = e.span().map(|s| (s.start, line_col(text, s.start)));
             let msg = e.message().trim().to_string();
-            let path = at
-                .map(|(l, c)| format!("(syntax, line {l}, column {c})"))
-                .unwrap_or_else(|| "(syntax)".into());
-            return Err(vec![SceneError::new(path, msg)]);
+            // a bad value on a `key = value` line is reported at the key's path
+            let error = match at {
+                Some((offset, (l, c))) => match key_at(text, offset) {
+                    Some(key) => SceneError::new(key, format!("{msg} (line {l}, column {c})")),
+                    None => SceneError::new(format!("(syntax, line {l}, column {c})"), msg),
+                },
+                None => SceneError::new("(syntax)", msg),
+            };
+            return Err(vec![error]);
         }
     };
     let mut errors = Vec::new();
@@ -235,46 +387,17 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
             || format!("must be >= 1, got {}", g.count),
         );
         total = total.saturating_add(g.count);
-        match g.shape {
-            ShapeSpec::Sphere { radius } => {
-                finite_positive(&mut errors, &format!("{p}.shape.radius"), radius)
-            }
-            ShapeSpec::Superquadric {
-                semi_axes,
-                exponents,
-            } => {
-                for (k, a) in semi_axes.iter().enumerate() {
-                    finite_positive(&mut errors, &format!("{p}.shape.semi_axes[{k}]"), *a);
-                }
-                for (k, g) in exponents.iter().enumerate() {
-                    exponent_in_range(&mut errors, &format!("{p}.shape.exponents[{k}]"), *g);
-                }
-            }
-            ShapeSpec::Superball {
-                semi_axis,
-                exponent,
-            } => {
-                finite_positive(&mut errors, &format!("{p}.shape.semi_axis"), semi_axis);
-                exponent_in_range(&mut errors, &format!("{p}.shape.exponent"), exponent);
-            }
-            ShapeSpec::Ellipsoid { semi_axes } => {
-                for (k, a) in semi_axes.iter().enumerate() {
-                    finite_positive(&mut errors, &format!("{p}.shape.semi_axes[{k}]"), *a);
-                }
-            }
-            ShapeSpec::Spherocylinder {
-                radius,
-                cylinder_length,
-            } => {
-                finite_positive(&mut errors, &format!("{p}.shape.radius"), radius);
-                check(
-                    &mut errors,
-                    cylinder_length.is_finite() && cylinder_length >= 0.0,
-                    &format!("{p}.shape.cylinder_length"),
-                    || format!("must be a finite number >= 0, got {cylinder_length}"),
-                );
-            }
-        }
+        shape_checks(&p, &g.shape, &mut errors);
+    }
+    size_ratio_check(&particles, &mut errors);
+    if let Some(toml::Value::Array(items)) = table.get("particles")
+        && items.is_empty()
+        && pipeline.as_ref().is_some_and(|p| p.needs_particles())
+    {
+        errors.push(SceneError::new(
+            "particles",
+            "is empty: give at least one [[particles]] entry",
+        ));
     }
     check(&mut errors, total <= 10_000_000, "particles", || {
         format!("at most 10^7 particles in all, got {total}")

@@ -1,6 +1,7 @@
 //! Integration tests, one binary: every module below was a test file of its own. One
 //! binary links the crate once, which keeps CI's build time and disk use down.
 
+mod bad_scenes;
 mod bench_brownian;
 mod brownian_capture;
 mod brownian_hydro;

@@ -68,6 +68,11 @@ impl Pipeline for BrownianPipeline {
         if let Some(b) = &section {
             scene::validate_section(b, cx.errors);
         }
+        let fibre_errors = cx
+            .errors
+            .iter()
+            .any(|e| e.path.starts_with("fibres") || e.path.starts_with("fibre_packings"));
+        let fibres = (!fibre_errors).then_some(cx.fibres);
         for (i, g) in cx.particles.iter() {
             let p = format!("particles[{i}]");
             match g.shape {
@@ -77,7 +82,7 @@ impl Pipeline for BrownianPipeline {
                     radius,
                     g.moment.as_ref(),
                     g.placement.as_ref(),
-                    cx.fibres,
+                    fibres,
                     cx.errors,
                 ),
                 _ => cx.errors.push(SceneError::new(

@@ -39,7 +39,19 @@ use magsep_components::brownian::{
 };
 use serde::{Deserialize, Serialize};
 
+use crate::scene::checks::{LENGTH_RANGE, num, within};
 use crate::scene::{FibreSpec, PlacementSpec, SceneError};
+
+/// Temperatures accepted \[K\].
+pub const TEMPERATURE_RANGE: (f64, f64) = (1e-3, 1e4);
+/// Viscosities accepted \[Pa s\] (a gas to a stiff paste).
+pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
+/// The largest magnetisation a particle's moment may imply \[A/m\]: m / V at most this
+/// (iron saturates at 1.7e6 A/m; no material exceeds 2e6 A/m).
+pub const MAX_MAGNETISATION: f64 = 2e6;
+/// Start regions: their extents (gap, height, thickness, box edges) at most this \[m\],
+/// and box corners within this distance of the origin.
+pub const MAX_REGION: f64 = 1.0;
 
 /// `[brownian]`: every key but `time_step` and `duration` optional.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -151,10 +163,12 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
         ));
     }
     if let Some(t) = b.temperature {
-        positive(errors, "brownian.temperature", t, " [K]");
+        let (lo, hi) = TEMPERATURE_RANGE;
+        within(errors, "brownian.temperature", t, lo, hi, "[K]");
     }
     if let Some(v) = b.viscosity {
-        positive(errors, "brownian.viscosity", v, " [Pa s]");
+        let (lo, hi) = VISCOSITY_RANGE;
+        within(errors, "brownian.viscosity", v, lo, hi, "[Pa s]");
     }
     if let Some(t) = b.krylov_tolerance
         && !(t.is_finite() && t > 0.0 && t <= 0.1)
@@ -228,26 +242,39 @@ pub fn validate_group(
     radius: f64,
     moment: Option<&MomentModel>,
     placement: Option<&PlacementSpec>,
-    fibres: &[FibreSpec],
+    fibres: Option<&[FibreSpec]>,
     errors: &mut Vec<SceneError>,
 ) {
-    match moment {
-        Some(MomentModel::Saturated { moment }) => {
-            positive(errors, &format!("{p}.moment.moment"), *moment, " [A m²]")
+    // a moment above MAX_MAGNETISATION times the particle's volume is not a material's
+    let volume = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+    let largest = MAX_MAGNETISATION * volume;
+    let moment_in_range = |errors: &mut Vec<SceneError>, key: &str, m: f64| {
+        if !(m.is_finite() && m > 0.0 && m <= largest) {
+            errors.push(SceneError::new(
+                format!("{p}.moment.{key}"),
+                format!(
+                    "must be in (0, {}] [A m²] (a sphere of radius {} m magnetised at {} A/m), got {m}",
+                    num(largest),
+                    num(radius),
+                    num(MAX_MAGNETISATION)
+                ),
+            ));
         }
+    };
+    match moment {
+        Some(MomentModel::Saturated { moment }) => moment_in_range(errors, "moment", *moment),
         Some(MomentModel::Langevin {
             moment,
             domain_moment,
         }) => {
-            positive(errors, &format!("{p}.moment.moment"), *moment, " [A m²]");
-            positive(
-                errors,
-                &format!("{p}.moment.domain_moment"),
-                *domain_moment,
-                " [A m²]",
-            );
+            moment_in_range(errors, "moment", *moment);
+            moment_in_range(errors, "domain_moment", *domain_moment);
         }
-        _ => {}
+        Some(MomentModel::None) => {}
+        None => errors.push(SceneError::new(
+            format!("{p}.moment"),
+            "missing required key (the moment law; kind = \"none\" for non-magnetic particles)",
+        )),
     }
     let Some(placement) = placement else {
         errors.push(SceneError::new(
@@ -257,17 +284,42 @@ pub fn validate_group(
         return;
     };
     let q = format!("{p}.placement");
+    // `fibres` is None when a fibre entry is invalid: its errors say enough
     let check_fibre = |k: usize, errors: &mut Vec<SceneError>| {
-        if k >= fibres.len() {
+        if let Some(fibres) = fibres
+            && k >= fibres.len()
+        {
             errors.push(SceneError::new(
                 format!("{q}.fibre"),
                 format!("no fibre {k}: the scene has {} [[fibres]]", fibres.len()),
             ));
         }
     };
+    let extent = |errors: &mut Vec<SceneError>, key: &str, v: f64| {
+        within(
+            errors,
+            &format!("{q}.{key}"),
+            v,
+            LENGTH_RANGE.0,
+            MAX_REGION,
+            "[m]",
+        )
+    };
     match placement {
         PlacementSpec::Box { min, max } => {
-            if !(0..3).all(|k| min[k].is_finite() && max[k].is_finite() && max[k] > min[k]) {
+            for (key, corner) in [("min", min), ("max", max)] {
+                for (k, &v) in corner.iter().enumerate() {
+                    within(
+                        errors,
+                        &format!("{q}.{key}[{k}]"),
+                        v,
+                        -MAX_REGION,
+                        MAX_REGION,
+                        "[m]",
+                    );
+                }
+            }
+            if !(0..3).all(|k| max[k] > min[k]) {
                 errors.push(SceneError::new(
                     format!("{q}.max"),
                     format!("must exceed min on every axis, got min {min:?}, max {max:?}"),
@@ -276,7 +328,8 @@ pub fn validate_group(
         }
         PlacementSpec::FibreTop { fibre, gap, height } => {
             check_fibre(*fibre, errors);
-            positive(errors, &format!("{q}.height"), *height, " [m]");
+            extent(errors, "height", *height);
+            extent(errors, "gap", *gap);
             if !(gap.is_finite() && *gap > radius) {
                 errors.push(SceneError::new(
                     format!("{q}.gap"),
@@ -290,7 +343,8 @@ pub fn validate_group(
             thickness,
         } => {
             check_fibre(*fibre, errors);
-            positive(errors, &format!("{q}.thickness"), *thickness, " [m]");
+            extent(errors, "thickness", *thickness);
+            extent(errors, "gap", *gap);
             if !(gap.is_finite() && *gap > radius) {
                 errors.push(SceneError::new(
                     format!("{q}.gap"),
@@ -311,11 +365,17 @@ pub fn validate_group(
             }
             if let Some(k) = positions
                 .iter()
-                .position(|p| !p.iter().all(|v| v.is_finite()))
+                .position(|p| !p.iter().all(|v| v.is_finite() && v.abs() <= MAX_REGION))
             {
                 errors.push(SceneError::new(
                     format!("{q}.positions[{k}]"),
-                    "must be three finite numbers [m]",
+                    format!("must be three finite numbers in [-{MAX_REGION}, {MAX_REGION}] [m]"),
+                ));
+            }
+            if let Some((a, b)) = crate::scene::placement::first_overlap(positions, radius) {
+                errors.push(SceneError::new(
+                    format!("{q}.positions[{b}]"),
+                    format!("overlaps positions[{a}]: centres closer than a diameter"),
                 ));
             }
         }

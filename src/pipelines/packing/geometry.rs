@@ -11,7 +11,7 @@ use magsep_components::packing::OverlapRemovalScheme;
 use magsep_components::shape::Shape;
 
 use super::scene::{ContainerSpec, PackingSection};
-use crate::scene::checks::{check, finite_positive};
+use crate::scene::checks::{check, finite_positive, num};
 use crate::scene::{ParticleGroup, SceneError, ShapeSpec};
 
 fn is_superquadric(s: &ShapeSpec) -> bool {
@@ -23,6 +23,10 @@ fn is_superquadric(s: &ShapeSpec) -> bool {
 
 /// Cross-shape, scheme and container checks of a packing scene (after the per-field checks
 /// passed).
+/// Largest fixed container dimension (cylinder radius, wedge length, slab side), in
+/// diameters of the smallest particle.
+pub const MAX_CONTAINER_DIAMETERS: f64 = 1000.0;
+
 pub(crate) fn validate(
     container: Option<&ContainerSpec>,
     groups: &[&ParticleGroup],
@@ -62,9 +66,29 @@ pub(crate) fn validate(
     } else {
         largest_radius
     };
+    // a fixed container dimension spans at most MAX_CONTAINER_DIAMETERS particles (the
+    // neighbour grid's cells grow with its square)
+    let smallest = shapes
+        .iter()
+        .map(|s| s.radius())
+        .fold(f64::INFINITY, f64::min);
+    let at_most = MAX_CONTAINER_DIAMETERS * 2.0 * smallest;
+    let fixed = |errors: &mut Vec<SceneError>, key: &str, v: f64| {
+        if smallest.is_finite() {
+            check(errors, v <= at_most, &format!("container.{key}"), || {
+                format!(
+                    "must be at most {MAX_CONTAINER_DIAMETERS} diameters of the smallest particle \
+                     ({} m), got {}",
+                    num(at_most),
+                    num(v)
+                )
+            });
+        }
+    };
     match container {
         Some(ContainerSpec::Cylinder { radius }) => {
             finite_positive(errors, "container.radius", *radius);
+            fixed(errors, "radius", *radius);
             check(errors, *radius > needed, "container.radius", || {
                 format!("must exceed the largest particle radius {needed:e} m, got {radius:e}")
             });
@@ -77,6 +101,7 @@ pub(crate) fn validate(
                 || format!("must be in (0, pi/2) rad, got {angle}"),
             );
             finite_positive(errors, "container.length", *length);
+            fixed(errors, "length", *length);
             let t = angle.tan();
             let inscribed = length * t / (1.0 + t + 1.0 / angle.cos());
             check(errors, inscribed > needed, "container.length", || {
@@ -86,7 +111,23 @@ pub(crate) fn validate(
                 )
             });
         }
-        Some(ContainerSpec::Slab { side }) => finite_positive(errors, "container.side", *side),
+        Some(ContainerSpec::Slab { side }) => {
+            finite_positive(errors, "container.side", *side);
+            fixed(errors, "side", *side);
+            // a period must hold a particle and its image apart
+            check(
+                errors,
+                *side > 2.0 * largest_bound,
+                "container.side",
+                || {
+                    format!(
+                        "must exceed the largest particle's bounding diameter {} m, got {}",
+                        num(2.0 * largest_bound),
+                        num(*side)
+                    )
+                },
+            );
+        }
         Some(ContainerSpec::PeriodicBox {}) | Some(ContainerSpec::ClosedBox {}) | None => {}
     }
 }

@@ -11,7 +11,7 @@ use magsep_systems::rng::particle_stream;
 use serde::{Deserialize, Serialize};
 
 use super::geometry::start_container;
-use crate::scene::checks::{check, finite_positive, in_range};
+use crate::scene::checks::{check, finite_positive, in_range, within};
 use crate::scene::{ParseContext, Scene, SceneError, SpawnError};
 
 /// The validated sections of a packing scene.
@@ -61,7 +61,7 @@ pub enum ContainerSpec {
 pub struct PackingSection {
     /// Overlap-removal rule. Default `fire`.
     pub scheme: Option<OverlapRemovalScheme>,
-    /// Start packing fraction. Default 0.05. Range (0, 0.3].
+    /// Start packing fraction. Default 0.05. Range [0.001, 0.3].
     pub initial_packing_fraction: Option<f64>,
     /// Volume step [m^3]. Default 0.1 D^3.
     pub volume_step: Option<f64>,
@@ -69,7 +69,8 @@ pub struct PackingSection {
     pub volume_step_rule: Option<VolumeStepRule>,
     /// Adaptive rule's initial free-volume fraction. Default 0.01. Range (0, 0.5].
     pub adaptive_initial_fraction: Option<f64>,
-    /// Attempt budget per compression step. Default 20000 N (fire), 200 N (others).
+    /// Attempt budget per compression step. Default 20000 N (fire), 200 N (others). Range
+    /// 1..=1e9.
     pub max_attempts: Option<u64>,
     /// Halvings before the stop. Default 4. Range 0..=30.
     pub step_halvings: Option<u32>,
@@ -81,7 +82,7 @@ pub struct PackingSection {
     pub original_beta: Option<f64>,
     /// Original xi [m^2]. Default: I_xy / m per particle.
     pub original_xi: Option<f64>,
-    /// Step limit. Default 10^7.
+    /// Step limit. Default 10^7. Range 1..=1e9.
     pub max_compression_steps: Option<u64>,
     /// Observe every n steps (0: final only). Default 0.
     pub observe_every: Option<u64>,
@@ -126,7 +127,7 @@ pub fn packing_config(scene: &Scene) -> PackingConfig {
 /// Check the `[packing]` values.
 fn validate_packing(pk: &PackingSection, errors: &mut Vec<SceneError>) {
     if let Some(v) = pk.initial_packing_fraction {
-        in_range(errors, "packing.initial_packing_fraction", v, 0.0, 0.3);
+        within(errors, "packing.initial_packing_fraction", v, 1e-3, 0.3, "");
     }
     if let Some(v) = pk.volume_step {
         finite_positive(errors, "packing.volume_step", v);
@@ -135,9 +136,12 @@ fn validate_packing(pk: &PackingSection, errors: &mut Vec<SceneError>) {
         in_range(errors, "packing.adaptive_initial_fraction", v, 0.0, 0.5);
     }
     if let Some(v) = pk.max_attempts {
-        check(errors, v >= 1, "packing.max_attempts", || {
-            format!("must be >= 1, got {v}")
-        });
+        check(
+            errors,
+            (1..=1_000_000_000).contains(&v),
+            "packing.max_attempts",
+            || format!("must be in 1..=1e9, got {v}"),
+        );
     }
     if let Some(v) = pk.step_halvings {
         check(errors, v <= 30, "packing.step_halvings", || {
@@ -157,9 +161,12 @@ fn validate_packing(pk: &PackingSection, errors: &mut Vec<SceneError>) {
         finite_positive(errors, "packing.original_xi", v);
     }
     if let Some(v) = pk.max_compression_steps {
-        check(errors, v >= 1, "packing.max_compression_steps", || {
-            format!("must be >= 1, got {v}")
-        });
+        check(
+            errors,
+            (1..=1_000_000_000).contains(&v),
+            "packing.max_compression_steps",
+            || format!("must be in 1..=1e9, got {v}"),
+        );
     }
 }
 

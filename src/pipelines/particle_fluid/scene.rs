@@ -46,7 +46,7 @@ use magsep_systems::fluid::flow::FlowModel;
 use magsep_systems::fluid::magnet::{Liquid, MagnetModel};
 use serde::{Deserialize, Serialize};
 
-use crate::scene::checks::{check, finite_positive};
+use crate::scene::checks::{LENGTH_RANGE, check, finite_positive, within};
 use crate::scene::{ParticleGroup, PlacementSpec, SceneError, ShapeSpec};
 
 /// `[particle_fluid]`: every key but `time_step` and `duration` optional.
@@ -288,6 +288,55 @@ pub fn count_from_volume_fraction(fraction: f64, fluid_volume: f64, radius: f64)
     (fraction * fluid_volume / vp).floor() as u64
 }
 
+/// Densities accepted, of liquids and particles \[kg/m³\] (osmium is 22.6e3).
+pub const DENSITY_RANGE: (f64, f64) = (1.0, 3e4);
+/// Viscosities accepted \[Pa s\].
+pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
+/// Largest container edge, magnet size or position \[m\].
+pub const MAX_EXTENT: f64 = 100.0;
+/// Largest magnet surface field \[A/m\] (the strongest permanent magnets give about 1e6).
+pub const MAX_FIELD: f64 = 1e8;
+/// Largest flow or particle speed \[m/s\] (the model is Stokes-Oseen drag in a liquid).
+pub const MAX_SPEED: f64 = 100.0;
+/// Largest shear rate or flow frequency \[1/s\].
+pub const MAX_RATE: f64 = 1e6;
+
+/// The flow's values: finite, speeds at most [`MAX_SPEED`], rates at most [`MAX_RATE`].
+fn flow_checks(flow: &FlowModel, errors: &mut Vec<SceneError>) {
+    let speed = |errors: &mut Vec<SceneError>, key: &str, v: &[f64; 3]| {
+        for (k, c) in v.iter().enumerate() {
+            let path = format!("liquid.flow.{key}[{k}]");
+            within(errors, &path, *c, -MAX_SPEED, MAX_SPEED, "[m/s]");
+        }
+    };
+    match flow {
+        FlowModel::Quiescent => {}
+        FlowModel::Uniform { velocity } => speed(errors, "velocity", velocity),
+        FlowModel::Shear { rate } => within(
+            errors,
+            "liquid.flow.rate",
+            *rate,
+            -MAX_RATE,
+            MAX_RATE,
+            "[1/s]",
+        ),
+        FlowModel::Oscillating {
+            amplitude,
+            frequency,
+        } => {
+            speed(errors, "amplitude", amplitude);
+            within(
+                errors,
+                "liquid.flow.frequency",
+                *frequency,
+                1e-9,
+                MAX_RATE,
+                "[Hz]",
+            );
+        }
+    }
+}
+
 /// Check the particle-fluid sections; resolve `count` from `volume_fraction`.
 pub fn validate(
     pf: &ParticleFluidScene,
@@ -333,8 +382,25 @@ pub fn validate(
             || format!("must be >= time_step and at most 1.6e7 steps [s], got {window}"),
         );
     }
-    finite_positive(errors, "liquid.density", pf.liquid.density);
-    finite_positive(errors, "liquid.viscosity", pf.liquid.viscosity);
+    let (lo, hi) = DENSITY_RANGE;
+    within(
+        errors,
+        "liquid.density",
+        pf.liquid.density,
+        lo,
+        hi,
+        "[kg/m³]",
+    );
+    let (lo, hi) = VISCOSITY_RANGE;
+    within(
+        errors,
+        "liquid.viscosity",
+        pf.liquid.viscosity,
+        lo,
+        hi,
+        "[Pa s]",
+    );
+    flow_checks(&pf.liquid.flow, errors);
     let chi = pf.liquid.susceptibility;
     check(
         errors,
@@ -342,27 +408,40 @@ pub fn validate(
         "liquid.susceptibility",
         || format!("must be in [-1, 10], got {chi}"),
     );
-    if let FlowModel::Oscillating { frequency, .. } = pf.liquid.flow {
-        finite_positive(errors, "liquid.flow.frequency", frequency);
-    }
     if let Some(m) = &pf.magnet {
-        check(
+        within(
             errors,
-            m.surface_field.is_finite() && m.surface_field >= 0.0,
             "magnet.surface_field",
-            || {
-                format!(
-                    "must be a finite number >= 0 [A/m], got {}",
-                    m.surface_field
-                )
-            },
+            m.surface_field,
+            0.0,
+            MAX_FIELD,
+            "[A/m]",
         );
-        finite_positive(errors, "magnet.pole_size", m.pole_size);
-        finite_positive(errors, "magnet.half_height", m.half_height);
+        within(
+            errors,
+            "magnet.pole_size",
+            m.pole_size,
+            LENGTH_RANGE.0,
+            MAX_EXTENT,
+            "[m]",
+        );
+        within(
+            errors,
+            "magnet.half_height",
+            m.half_height,
+            LENGTH_RANGE.0,
+            MAX_EXTENT,
+            "[m]",
+        );
         if let Some(z) = m.mid_plane {
-            check(errors, z.is_finite(), "magnet.mid_plane", || {
-                format!("must be finite [m], got {z}")
-            });
+            within(
+                errors,
+                "magnet.mid_plane",
+                z,
+                -MAX_EXTENT,
+                MAX_EXTENT,
+                "[m]",
+            );
         }
     }
     if let Err(e) = pf.collisions.model(&pf.liquid).validate() {
@@ -371,8 +450,13 @@ pub fn validate(
     let edges = pf.container.edges();
     let bounded = !matches!(pf.container, FluidContainerSpec::Unbounded {});
     if bounded {
-        for k in 0..3 {
-            finite_positive(errors, &format!("container.edges[{k}]"), edges[k]);
+        let keys = match pf.container {
+            FluidContainerSpec::Channel { .. } => ["side[0]", "side[1]", "height"],
+            _ => ["edges[0]", "edges[1]", "edges[2]"],
+        };
+        for (k, key) in keys.iter().enumerate() {
+            let path = format!("container.{key}");
+            within(errors, &path, edges[k], LENGTH_RANGE.0, MAX_EXTENT, "[m]");
         }
     }
     let d_max = groups
@@ -419,10 +503,14 @@ fn validate_group(
         return;
     };
     match (g.density, &g.density_ratios) {
-        (Some(rho), None) => finite_positive(errors, &format!("{p}.density"), rho),
+        (Some(rho), None) => {
+            let (lo, hi) = DENSITY_RANGE;
+            within(errors, &format!("{p}.density"), rho, lo, hi, "[kg/m³]")
+        }
         (None, Some(r)) => {
             let q = format!("{p}.density_ratios");
-            finite_positive(errors, &format!("{q}.min"), r.min);
+            within(errors, &format!("{q}.min"), r.min, 1e-3, 1e3, "");
+            within(errors, &format!("{q}.max"), r.max, 1e-3, 1e3, "");
             check(
                 errors,
                 r.max.is_finite() && r.max >= r.min,
@@ -441,9 +529,9 @@ fn validate_group(
     if let Some(v) = g.velocity {
         check(
             errors,
-            v.iter().all(|c| c.is_finite()),
+            v.iter().all(|c| c.is_finite() && c.abs() <= MAX_SPEED),
             &format!("{p}.velocity"),
-            || "must be three finite numbers [m/s]".into(),
+            || format!("must be three numbers in [-{MAX_SPEED}, {MAX_SPEED}] [m/s], got {v:?}"),
         );
     }
     match g.volume_fraction {
@@ -503,6 +591,12 @@ fn validate_group(
                 check(errors, inside, &format!("{q}.positions[{k}]"), || {
                     format!("must be finite and inside the container, got {x:?}")
                 });
+            }
+            if let Some((a, b)) = crate::scene::placement::first_overlap(positions, radius) {
+                errors.push(SceneError::new(
+                    format!("{q}.positions[{b}]"),
+                    format!("overlaps positions[{a}]: centres closer than a diameter"),
+                ));
             }
         }
         Some(PlacementSpec::Injection {
