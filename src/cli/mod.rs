@@ -80,11 +80,18 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Memory budget [GiB] the scene's estimated memory must fit (default: 16 GiB or
+        /// 3/4 of the machine's memory, whichever is smaller; or MAGSEP_MEMORY_BUDGET).
+        #[arg(long, value_name = "GiB")]
+        memory_budget: Option<f64>,
     },
     /// Validate a scene: exit 0 if valid, 2 with every error (and its key path) if not.
     Validate {
         /// Scene file (TOML).
         scene: PathBuf,
+        /// Memory budget [GiB] (as for `run`).
+        #[arg(long, value_name = "GiB")]
+        memory_budget: Option<f64>,
     },
     /// Channels, frame count and metadata of a recording.
     Info {
@@ -219,8 +226,12 @@ pub fn main_with(ext: Extensions) -> i32 {
             seed,
             quiet,
             threads,
-        } => run::run(&ext, &scene, record, seed, quiet, threads),
-        Command::Validate { scene } => run::validate(&ext, &scene),
+            memory_budget,
+        } => run::run(&ext, &scene, record, seed, quiet, threads, memory_budget),
+        Command::Validate {
+            scene,
+            memory_budget,
+        } => run::validate(&ext, &scene, memory_budget),
         Command::Field {
             scene,
             points,

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::{Progress, RunOptions, Scene, load_scene};
 use crate::sim::{SimError, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -28,8 +29,21 @@ fn load(ext: &Extensions, path: &Path) -> Result<Scene, CliError> {
         .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))
 }
 
-pub fn validate(ext: &Extensions, path: &Path) -> Result<(), CliError> {
+/// The scene's memory estimate, checked against the budget (exit 2 when over).
+fn memory(
+    scene: &Scene,
+    path: &Path,
+    budget_gib: Option<f64>,
+) -> Result<(MemoryEstimate, u64), CliError> {
+    let budget = memory::budget(budget_gib).map_err(CliError::input)?;
+    let estimate = memory::check(scene, budget)
+        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))?;
+    Ok((estimate, budget))
+}
+
+pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Result<(), CliError> {
     let scene = load(ext, path)?;
+    let (estimate, budget) = memory(&scene, path, budget_gib)?;
     println!(
         "{}",
         serde_json::json!({
@@ -38,6 +52,9 @@ pub fn validate(ext: &Extensions, path: &Path) -> Result<(), CliError> {
             "pipeline": scene.pipeline_name(),
             "particles": scene.total_particles(),
             "fibres": scene.fibres.len(),
+            "memory_estimate_bytes": estimate.bytes.round() as u64,
+            "memory_estimate": estimate.detail,
+            "memory_budget_bytes": budget,
         })
     );
     Ok(())
@@ -71,9 +88,11 @@ pub fn run(
     seed: Option<u64>,
     quiet: bool,
     threads: Option<usize>,
+    budget_gib: Option<f64>,
 ) -> Result<(), CliError> {
     let single = set_threads(threads)?;
     let scene = load(ext, path)?;
+    memory(&scene, path, budget_gib)?;
     let options = RunOptions {
         seed,
         record,

@@ -19,6 +19,7 @@
 pub mod checks;
 mod fibre_packing;
 mod fibres;
+pub mod memory;
 pub mod pipeline;
 pub mod placement;
 mod sections;

@@ -177,6 +177,13 @@ pub trait Pipeline: Send + Sync + 'static {
         &[]
     }
 
+    /// The scene's peak memory, estimated before anything is allocated (checked against
+    /// the memory budget by `magsep run` and printed by `magsep validate`). Default:
+    /// [`memory::default_estimate`](super::memory::default_estimate), 4 KiB per particle.
+    fn memory_estimate(&self, scene: &Scene) -> super::memory::MemoryEstimate {
+        super::memory::default_estimate(scene)
+    }
+
     /// Whether a scene of this pipeline needs at least one `[[particles]]` entry.
     fn needs_particles(&self) -> bool {
         true

@@ -36,6 +36,37 @@ impl Pipeline for BrownianPipeline {
         "brownian"
     }
 
+    fn memory_estimate(&self, scene: &Scene) -> crate::scene::memory::MemoryEstimate {
+        use magsep_components::brownian::MobilityChoice;
+        let mut estimate = crate::scene::memory::MemoryEstimate::per_particle(scene, 5120.0);
+        let Some(section) = scene.section::<BrownianSection>() else {
+            return estimate;
+        };
+        // the dense 3N x 3N RPY mobility (72 N^2 bytes), and its Cholesky factor as much
+        // again; auto takes Cholesky up to N = 300, a dense operator above
+        let n = scene.total_particles() as f64;
+        let dense = 72.0 * n * n;
+        let hydro = match section.config().mobility {
+            MobilityChoice::FreeDraining => 0.0,
+            MobilityChoice::Cholesky => 2.0 * dense,
+            _ => dense,
+        };
+        // replicates run in parallel, one world each
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let parallel = section.runs().min(threads) as f64;
+        let per_run = estimate.bytes - crate::scene::memory::BASE_BYTES + hydro;
+        estimate.bytes = crate::scene::memory::BASE_BYTES + parallel * per_run;
+        if hydro > 0.0 {
+            estimate.key = "brownian.mobility".into();
+        }
+        estimate.detail = format!(
+            "{n} particles at 5 KB, {} of hydrodynamic mobility, times {parallel} replicates \
+             in parallel",
+            crate::scene::memory::gib(hydro)
+        );
+        estimate
+    }
+
     fn description(&self) -> &'static str {
         "Brownian dynamics and capture of magnetic nanoparticles around magnetised fibres"
     }

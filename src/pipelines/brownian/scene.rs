@@ -42,16 +42,17 @@ use serde::{Deserialize, Serialize};
 use crate::scene::checks::{LENGTH_RANGE, num, within};
 use crate::scene::{FibreSpec, PlacementSpec, SceneError};
 
-/// Temperatures accepted \[K\].
-pub const TEMPERATURE_RANGE: (f64, f64) = (1e-3, 1e4);
+/// Temperatures accepted \[K\] (a temperature near 0 switches the noise off, for
+/// deterministic checks).
+pub const TEMPERATURE_RANGE: (f64, f64) = (1e-20, 1e4);
 /// Viscosities accepted \[Pa s\] (a gas to a stiff paste).
 pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
 /// The largest magnetisation a particle's moment may imply \[A/m\]: m / V at most this
 /// (iron saturates at 1.7e6 A/m; no material exceeds 2e6 A/m).
 pub const MAX_MAGNETISATION: f64 = 2e6;
-/// Start regions: their extents (gap, height, thickness, box edges) at most this \[m\],
-/// and box corners within this distance of the origin.
-pub const MAX_REGION: f64 = 1.0;
+/// Start regions: their extents (gap, height, thickness) at most this \[m\], and box
+/// corners and points within this distance of the origin (the fibres' range too).
+pub const MAX_REGION: f64 = LENGTH_RANGE.1;
 
 /// `[brownian]`: every key but `time_step` and `duration` optional.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -270,11 +271,8 @@ pub fn validate_group(
             moment_in_range(errors, "moment", *moment);
             moment_in_range(errors, "domain_moment", *domain_moment);
         }
-        Some(MomentModel::None) => {}
-        None => errors.push(SceneError::new(
-            format!("{p}.moment"),
-            "missing required key (the moment law; kind = \"none\" for non-magnetic particles)",
-        )),
+        // optional: a group without `moment` is non-magnetic (as `kind = "none"`)
+        Some(MomentModel::None) | None => {}
     }
     let Some(placement) = placement else {
         errors.push(SceneError::new(

@@ -31,6 +31,14 @@ impl Pipeline for PackingPipeline {
         "packing"
     }
 
+    fn memory_estimate(&self, scene: &Scene) -> crate::scene::memory::MemoryEstimate {
+        // particles (twice the measured 1.6 KB each) and the neighbour grid: about one cell
+        // of 16 bytes per particle diameter cubed of the start box, V_p / phi0 per particle
+        let phi0 = scene::packing_config(scene).initial_packing_fraction;
+        let per_cell = 16.0 * std::f64::consts::FRAC_PI_6 / phi0;
+        crate::scene::memory::MemoryEstimate::per_particle(scene, 4096.0 + per_cell)
+    }
+
     fn description(&self) -> &'static str {
         "random dense packings by mechanical contraction"
     }

@@ -31,6 +31,32 @@ impl Pipeline for ParticleFluidPipeline {
         "particle_fluid"
     }
 
+    fn memory_estimate(&self, scene: &Scene) -> crate::scene::memory::MemoryEstimate {
+        use magsep_systems::fluid::config::HistoryChoice;
+        let base = crate::scene::memory::MemoryEstimate::per_particle(scene, 4096.0);
+        let Some(pf) = scene.section::<ParticleFluidScene>() else {
+            return base;
+        };
+        // the Basset history keeps 2 x 64 bytes per particle and past step: measured 61
+        // bytes at a 200-step window, doubled
+        let s = &pf.section;
+        let steps = match s.history {
+            _ if !s.terms.history => 0.0,
+            HistoryChoice::Full => (s.duration / s.time_step).ceil(),
+            HistoryChoice::Window { window, .. } => (window / s.time_step).ceil(),
+        };
+        let per_particle = 4096.0 + 128.0 * steps;
+        let mut estimate = crate::scene::memory::MemoryEstimate::per_particle(scene, per_particle);
+        if steps * 128.0 > 4096.0 {
+            estimate.key = "particle_fluid.history".into();
+            estimate.detail = format!(
+                "{} particles, each with {steps} past steps of Basset history",
+                scene.total_particles()
+            );
+        }
+        estimate
+    }
+
     fn description(&self) -> &'static str {
         "inertial particles levitating and colliding in a magnetised liquid"
     }

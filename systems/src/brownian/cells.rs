@@ -36,6 +36,9 @@ impl Hasher for CellHasher {
 
 type CellMap = HashMap<[i64; 3], (u32, u32), BuildHasherDefault<CellHasher>>;
 
+/// Largest cell coordinate (2^60): far from `i64` overflow when offsets are added.
+const KEY_LIMIT: f64 = (1u64 << 60) as f64;
+
 /// Largest dense grid, in cells per binned particle (sparser sets use the hash map).
 const DENSE_CELLS_PER_PARTICLE: usize = 8;
 
@@ -66,7 +69,9 @@ pub struct CellList {
 
 impl CellList {
     fn key(&self, p: DVec3) -> [i64; 3] {
-        let q = (p - self.origin) * self.inv;
+        // clamped, so that neighbour offsets never overflow even for absurd positions
+        let q =
+            ((p - self.origin) * self.inv).clamp(DVec3::splat(-KEY_LIMIT), DVec3::splat(KEY_LIMIT));
         [q.x.floor() as i64, q.y.floor() as i64, q.z.floor() as i64]
     }
 
@@ -118,10 +123,17 @@ impl CellList {
             sorted: Vec::new(),
             index: Index::Sparse(CellMap::default()),
         };
-        let span = ((hi - lo) * list.inv).floor();
-        let dims = [span.x as i64 + 1, span.y as i64 + 1, span.z as i64 + 1];
-        let cells = dims.iter().map(|&d| d as f64).product::<f64>();
+        let span = ((hi - lo) * list.inv)
+            .floor()
+            .clamp(DVec3::ZERO, DVec3::splat(KEY_LIMIT));
+        let cells = (span + DVec3::ONE).element_product();
+        // NaN or huge spans (absurd positions) take the sparse map, never a dense grid
         let dense = cells <= (DENSE_CELLS_PER_PARTICLE * members.len().max(512)) as f64;
+        let dims = if dense {
+            [span.x as i64 + 1, span.y as i64 + 1, span.z as i64 + 1]
+        } else {
+            [0; 3]
+        };
         if !dense && reach > 1 {
             return Self::build_with_reach(positions, cutoff, 1, include);
         }
