@@ -6,6 +6,9 @@ use magsep::scene::{Registry, memory, parse_scene};
 
 const BUDGET: u64 = 16 << 30;
 
+/// A scene text for a particle count.
+type SceneOf<'a> = &'a dyn Fn(u64) -> String;
+
 fn packing(n: u64) -> String {
     format!(
         "[simulation]\npipeline = \"packing\"\n[container]\nkind = \"periodic_box\"\n\
@@ -44,7 +47,7 @@ fn fits(text: &str) -> (bool, String) {
 
 #[test]
 fn the_readme_limits_fit_a_16_gib_budget_and_ten_percent_more_does_not() {
-    let cases: [(&str, u64, &dyn Fn(u64) -> String, &str); 5] = [
+    let cases: [(&str, u64, SceneOf, &str); 5] = [
         ("packing", 4_000_000, &packing, "particles"),
         (
             "brownian free draining",
