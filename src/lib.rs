@@ -17,6 +17,7 @@ pub mod chart;
 pub mod cli;
 pub mod error;
 pub mod fieldtool;
+pub mod input;
 pub mod pipelines;
 pub mod replay;
 pub mod scene;

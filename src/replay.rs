@@ -12,14 +12,14 @@ use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
-use magsep_plugins::app::SimPlugin;
-use magsep_plugins::record::{ParticleFrame, Recording, read_recording};
-use magsep_plugins::recorder::FrameStatus;
+use magsep_plugins::app::{SimApp, SimPlugin};
+use magsep_plugins::record::{ParticleFrame, Recording, RecordingMetadata, read_recording};
+use magsep_plugins::recorder::{FrameStatus, gather_frame};
 use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
 
 pub use crate::error::ReplayError;
-use crate::scene::{Registry, RunOptions, parse_scene};
+use crate::scene::{Registry, RunOptions, Scene, parse_scene, spawn_scene};
 use crate::sim::{SimError, Simulation};
 
 /// Spawn the particles of `frame` into `world` and set the container, clock and status.
@@ -154,11 +154,108 @@ pub fn missing_systems(
     missing
 }
 
+/// Whether `a` and `b` agree to 1e-12 relative (time steps: the recorded `dt` is a decimal
+/// round trip of the run's).
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    a == b || (a - b).abs() <= rel * a.abs().max(b.abs())
+}
+
+/// Checks that the recorded scene (parsed from the recording's metadata) fits the frame a
+/// resume starts from, the checks `replay` makes and more, before the scene is spawned at
+/// its own size:
+///
+/// 1. the particle count of the scene equals the frame's (a scene text claiming 10^7
+///    particles over 10-particle frames is refused without spawning them);
+/// 2. the frame's step is within the scene's run (`Pipeline::total_steps`);
+/// 3. on the scene spawned once with the recorded seed (as many particles as the frame):
+///    its time step equals the recorded `dt` and the frame's time is step x dt (1e-9
+///    relative), so a changed `time_step` is refused;
+/// 4. when the recording holds its step-0 frame: that spawn reproduces it bitwise (ids,
+///    positions, orientations, radii, half lengths, random streams, box), so a different
+///    seed or placement is refused.
+///
+/// The recorded schedule is compared with this program's once the simulation is built
+/// ([`missing_systems`]).
+///
+/// # Errors
+/// [`ReplayError::BadFrame`] naming what differs.
+pub fn check_resume(
+    scene: &Scene,
+    meta: &RecordingMetadata,
+    rec: &Recording,
+    frame: &ParticleFrame,
+) -> Result<(), ReplayError> {
+    let bad = |detail: String| ReplayError::BadFrame {
+        step: frame.step,
+        detail,
+    };
+    let n = scene.total_particles();
+    if n != frame.ids.len() as u64 {
+        return Err(bad(format!(
+            "{} particles, the recorded scene has {n}: the scene text does not belong to \
+             these frames",
+            frame.ids.len()
+        )));
+    }
+    let Some(pipeline) = &scene.pipeline else {
+        return Err(ReplayError::Unsupported(
+            "the recorded scene is field-only: nothing to resume".into(),
+        ));
+    };
+    if let Some(total) = pipeline.total_steps(scene)
+        && frame.step > total
+    {
+        return Err(bad(format!(
+            "the recorded scene ends at step {total}, before the frame"
+        )));
+    }
+    let mut app = SimApp::new();
+    spawn_scene(scene, &mut app.world, meta.seed)
+        .map_err(|e| bad(format!("the recorded scene does not spawn: {e}")))?;
+    let start = gather_frame(&mut app.world);
+    let dt = app.world.get_resource::<StepClock>().map_or(0.0, |c| c.dt);
+    if !close(dt, meta.dt, 1e-12) {
+        return Err(bad(format!(
+            "the recorded scene has time step {dt} s, the recording {} s",
+            meta.dt
+        )));
+    }
+    if frame.step > 0 && !close(frame.time, frame.step as f64 * dt, 1e-9) {
+        return Err(bad(format!(
+            "time {} s is not step x time step = {} s",
+            frame.time,
+            frame.step as f64 * dt
+        )));
+    }
+    if let Some(first) = rec.frames.first().filter(|f| f.step == 0) {
+        let differs = [
+            ("particle ids", first.ids != start.ids),
+            ("positions", first.positions != start.positions),
+            ("orientations", first.orientations != start.orientations),
+            ("radii", first.radii != start.radii),
+            ("half lengths", first.half_lengths != start.half_lengths),
+            ("random streams", first.rng_states != start.rng_states),
+            ("box", first.box_edges != start.box_edges),
+        ];
+        let what: Vec<&str> = differs.iter().filter(|d| d.1).map(|d| d.0).collect();
+        if !what.is_empty() {
+            return Err(bad(format!(
+                "the recorded scene with seed {} does not reproduce the recording's first \
+                 frame (step 0): its {} differ; the scene text or the seed is not the run's",
+                meta.seed,
+                what.join(", ")
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Continue the run recorded in `path` from its last complete frame to the end of the scene,
 /// optionally recording the continuation to `record`; `plugins` are built after the
-/// pipeline's group (a program with user plugins passes the ones it ran with). Refused when the
-/// recorded schedule has systems this program's schedule lacks. Returns the summary of the
-/// whole run.
+/// pipeline's group (a program with user plugins passes the ones it ran with). The recorded
+/// scene must fit the frame ([`check_resume`]: particle count, time step, seed, steps),
+/// checked before the scene is spawned at its size, and refused when the recorded schedule
+/// has systems this program's schedule lacks. Returns the summary of the whole run.
 ///
 /// # Errors
 /// [`ReplayError`].
@@ -173,6 +270,7 @@ pub fn resume(
     let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
     let scene = parse_scene(&meta.scene_text, registry)?;
     let frame = last_frame(&rec)?.clone();
+    check_resume(&scene, &meta, &rec, &frame)?;
     let options = RunOptions {
         seed: Some(meta.seed),
         record,

@@ -95,8 +95,9 @@ pub use frame::{
     BackdropCube, FibreShape, ParticleFrame, PluginInfo, RecordingMetadata, WallShape,
 };
 pub use reader::{
-    ChannelInfo, Frames, Messages, MetadataRecord, RawMessage, ReadMode, ReaderLimits, Recording,
-    RecordingReader, SchemaInfo, read_recording, read_recording_bytes,
+    ChannelInfo, Frames, LastFrame, MAX_CHUNK_BYTES, Messages, MetadataRecord, RATIO_FREE_BYTES,
+    RawMessage, ReadMode, ReaderLimits, Recording, RecordingReader, SchemaInfo, open_regular,
+    read_last_frame, read_recording, read_recording_bytes, trailing_message,
 };
 pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
 pub use writer::{ChannelHandle, RecordingWriter, log_time_ns};

@@ -45,6 +45,7 @@ pub(crate) fn parse_metadata(map: &BTreeMap<String, String>) -> Result<Recording
             .ok_or_else(|| format!("metadata {METADATA_NAME:?} lacks key {key:?}"))
     };
     let bad = |key: &str, value: &str, e: &dyn std::fmt::Display| {
+        let value = crate::parse::clip(value);
         format!("metadata {METADATA_NAME:?} key {key:?} has value {value:?}: {e}")
     };
     let seed = get("seed")?;

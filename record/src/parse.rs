@@ -101,6 +101,16 @@ impl<'a> Cursor<'a> {
 }
 
 /// Formats up to 8 bytes as hex, for error messages.
+/// `s` cut to 64 characters (with `...`): strings read from a damaged file are quoted in
+/// error messages, never at full length.
+pub(crate) fn clip(s: &str) -> String {
+    const MAX: usize = 64;
+    match s.char_indices().nth(MAX) {
+        Some((i, _)) => format!("{}...", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
 pub(crate) fn hex_prefix(data: &[u8]) -> String {
     data.iter()
         .take(8)

@@ -9,10 +9,12 @@ use crate::fieldtool::{
     FieldScene, MapQuantity, csv_header, field_map, field_rows, parse_extent, parse_slice,
     read_points,
 };
-use crate::scene::load_scene;
+use crate::input::{MAX_POINTS_BYTES, read_text};
+use crate::scene::parse_scene;
 use magsep_systems::field::MomentModel;
 
 use super::CliError;
+use super::output::{Input, check_file, print, stdout_error};
 
 /// Options of `magsep field`.
 pub struct FieldArgs {
@@ -34,10 +36,22 @@ pub struct FieldArgs {
     pub moment: Option<f64>,
     /// Capture cut-off force [N].
     pub cutoff: f64,
+    /// Overwrite an existing `out` (never an input).
+    pub force: bool,
 }
 
-pub fn field(a: FieldArgs) -> Result<(), CliError> {
-    let scene = load_scene(&a.scene, &Default::default())
+/// `magsep field` with `threads` worker threads: `--out` is checked before anything runs.
+pub fn field(a: FieldArgs, threads: Option<usize>) -> Result<(), CliError> {
+    let text = super::run::scene_text(&a.scene)?;
+    if let Some(out) = &a.out {
+        let mut inputs = super::run::scene_inputs(&a.scene, &text);
+        if let Some(points) = &a.points {
+            inputs.push(Input::new("points file", points));
+        }
+        check_file("--out", out, &inputs, a.force)?;
+    }
+    super::run::set_threads(threads)?;
+    let scene = parse_scene(&text, &Default::default())
         .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", a.scene.display())))?;
     if scene.fibres.is_empty() && scene.external_field.is_none() {
         return Err(CliError::input(format!(
@@ -56,8 +70,7 @@ pub fn field(a: FieldArgs) -> Result<(), CliError> {
 }
 
 fn points_csv(fs: &FieldScene, path: &Path, gradient: bool) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("cannot read {}: {e}", path.display())))?;
+    let text = read_text(path, MAX_POINTS_BYTES).map_err(CliError::input)?;
     let points =
         read_points(&text).map_err(|e| CliError::input(format!("{}:\n{e}", path.display())))?;
     let rows = field_rows(fs, &points, gradient);
@@ -70,7 +83,7 @@ fn points_csv(fs: &FieldScene, path: &Path, gradient: bool) -> Result<(), CliErr
         }
         out.flush()
     };
-    write().map_err(|e| CliError::runtime(format!("writing stdout: {e}")))
+    write().map_err(stdout_error)
 }
 
 fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
@@ -159,16 +172,12 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
         .filter(|v| v.is_finite())
         .collect();
     let max = finite.iter().copied().fold(0.0, f64::max);
-    println!(
-        "{}",
-        serde_json::json!({
-            "out": out.display().to_string(),
-            "plane": format!("{plane}={}", slice.1),
-            "cells": a.resolution * a.resolution,
-            "quantity": label,
-            "max": max,
-            "capture_area_m2": capture_area,
-        })
-    );
-    Ok(())
+    print(serde_json::json!({
+        "out": out.display().to_string(),
+        "plane": format!("{plane}={}", slice.1),
+        "cells": a.resolution * a.resolution,
+        "quantity": label,
+        "max": max,
+        "capture_area_m2": capture_area,
+    }))
 }

@@ -2,10 +2,15 @@
 
 use std::path::Path;
 
-use crate::plugins::record::{RecordError, read_recording};
+use crate::input::named_inputs;
+use crate::plugins::record::{
+    ChannelInfo, ReadMode, ReaderLimits, RecordError, RecordingMetadata, RecordingReader,
+    trailing_message,
+};
 use crate::replay::{ReplayError, replay_with};
 use serde_json::json;
 
+use super::output::{Input, check_file, eprint, print};
 use super::{CliError, Extensions};
 
 fn record_error(path: &Path, e: RecordError) -> CliError {
@@ -18,103 +23,205 @@ fn record_error(path: &Path, e: RecordError) -> CliError {
     }
 }
 
+/// What `info` reports of a recording, read as a stream (one chunk and one frame in memory).
+struct Scan {
+    frames: u64,
+    first_step: Option<u64>,
+    last_step: Option<u64>,
+    particles: Option<usize>,
+    truncated: Option<String>,
+    damaged: Option<String>,
+    trailing_bytes: u64,
+    channels: Vec<ChannelInfo>,
+    metadata: Option<RecordingMetadata>,
+    summary_json: Option<String>,
+    file_bytes: u64,
+}
+
+/// Reads the recording at `path` linearly, checking every CRC; frames are decoded and
+/// counted, not kept. Fails (bad input) when nothing at all can be read.
+fn scan(path: &Path) -> Result<Scan, CliError> {
+    let mut reader = RecordingReader::open_with(path, ReadMode::Linear, ReaderLimits::default())
+        .map_err(|e| record_error(path, e))?;
+    let (mut frames, mut first_step, mut last_step, mut particles) = (0u64, None, None, None);
+    let mut failure = None;
+    for frame in reader.frames() {
+        match frame {
+            Ok(f) => {
+                frames += 1;
+                first_step.get_or_insert(f.step);
+                last_step = Some(f.step);
+                particles = Some(f.ids.len());
+            }
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        }
+    }
+    let trailing = reader.trailing_bytes();
+    let (truncated, damaged) = match failure {
+        Some(e) if frames == 0 => return Err(record_error(path, e)),
+        Some(e) => {
+            let msg = format!("{e}; reading stopped there: {frames} complete frames read");
+            (Some(msg.clone()), Some(msg))
+        }
+        None => (
+            reader.truncated().map(str::to_string),
+            trailing.map(|(at, n)| trailing_message(at, n)),
+        ),
+    };
+    Ok(Scan {
+        frames,
+        first_step,
+        last_step,
+        particles,
+        truncated,
+        damaged,
+        trailing_bytes: trailing.map_or(0, |t| t.1),
+        channels: reader.channels(),
+        metadata: reader.metadata().cloned(),
+        summary_json: reader.summary_json().map(str::to_string),
+        file_bytes: reader.file_bytes(),
+    })
+}
+
+/// `magsep info`: prints what can be read; exit 0 for a complete or a truncated file (a run
+/// that was killed), 2 for a damaged one (a corrupt record, bytes after the footer) after
+/// printing what could be read.
 pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
-    let rec = read_recording(path).map_err(|e| record_error(path, e))?;
+    let rec = scan(path)?;
+    let damaged = || match &rec.damaged {
+        Some(d) => Err(CliError::input(format!(
+            "{} is damaged: {d}",
+            path.display()
+        ))),
+        None => Ok(()),
+    };
     let channels: Vec<_> = rec
         .channels
         .iter()
         .map(|c| json!({"topic": c.topic, "schema": c.schema_name, "encoding": c.message_encoding, "messages": c.message_count}))
         .collect();
     let meta = rec.metadata.as_ref();
-    let v = json!({
-        "file": path.display().to_string(),
-        "bytes": rec.file_bytes,
-        "frames": rec.frames.len(),
-        "first_step": rec.frames.first().map(|f| f.step),
-        "last_step": rec.frames.last().map(|f| f.step),
-        "particles": rec.frames.last().map(|f| f.ids.len()),
-        "channels": channels,
-        "truncated": rec.truncated,
-        "complete": rec.truncated.is_none(),
-        "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
-        "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
-    });
     if as_json {
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-        return Ok(());
+        let v = json!({
+            "file": path.display().to_string(),
+            "bytes": rec.file_bytes,
+            "frames": rec.frames,
+            "first_step": rec.first_step,
+            "last_step": rec.last_step,
+            "particles": rec.particles,
+            "channels": channels,
+            "truncated": rec.truncated,
+            "damaged": rec.damaged,
+            "trailing_bytes": rec.trailing_bytes,
+            "complete": rec.truncated.is_none() && rec.damaged.is_none(),
+            "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
+            "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
+        });
+        print(serde_json::to_string_pretty(&v).unwrap_or_default())?;
+        return damaged();
     }
-    println!("file       {} ({} bytes)", path.display(), rec.file_bytes);
-    match &rec.truncated {
-        Some(t) => println!("status     TRUNCATED: {t}"),
-        None => println!("status     complete"),
+    let mut out = String::new();
+    let mut line = |text: String| {
+        out.push_str(&text);
+        out.push('\n');
+    };
+    line(format!(
+        "file       {} ({} bytes)",
+        path.display(),
+        rec.file_bytes
+    ));
+    match (&rec.damaged, &rec.truncated) {
+        (Some(d), _) => line(format!("status     DAMAGED: {d}")),
+        (None, Some(t)) => line(format!("status     TRUNCATED: {t}")),
+        (None, None) => line("status     complete".into()),
     }
-    println!(
+    line(format!(
         "frames     {} (steps {:?}..{:?})",
-        rec.frames.len(),
-        rec.frames.first().map(|f| f.step),
-        rec.frames.last().map(|f| f.step)
-    );
-    println!("channels");
+        rec.frames, rec.first_step, rec.last_step
+    ));
+    line("channels".into());
     for c in &rec.channels {
-        println!(
+        line(format!(
             "  {:<10} {:<24} {:<10} {} messages",
             c.topic, c.schema_name, c.message_encoding, c.message_count
-        );
+        ));
     }
-    if let Some(m) = meta {
-        println!(
-            "metadata   pipeline {}  seed {}  magsep {}  dt {} s",
-            m.pipeline, m.seed, m.version, m.dt
-        );
-        println!("schedule");
-        let order = [
-            "Prepare",
-            "Field",
-            "Dipole",
-            "Contact",
-            "Wall",
-            "Fluid",
-            "Custom",
-            "Accumulate",
-            "Mobility",
-            "Integrate",
-            "Constraints",
-            "Settle",
-            "WriteBack",
-            "Flags",
-            "Clock",
-            "Observe",
-            "Record",
-        ];
-        let rank = |s: &str| {
-            order
-                .iter()
-                .position(|o| s.starts_with(o))
-                .unwrap_or(order.len())
-        };
-        let mut sets: Vec<_> = m.schedule.iter().collect();
-        sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
-        for (set, systems) in sets {
-            let short: Vec<String> = systems
-                .iter()
-                .map(|s| s.rsplit("::").next().unwrap_or(s).to_string())
-                .collect();
-            println!("  {set:<12} {}", short.join(", "));
+    match meta {
+        Some(m) => {
+            line(format!(
+                "metadata   pipeline {}  seed {}  magsep {}  dt {} s",
+                m.pipeline, m.seed, m.version, m.dt
+            ));
+            line("schedule".into());
+            for l in schedule_lines(m) {
+                line(l);
+            }
+            line(format!(
+                "scene text ({} lines)",
+                m.scene_text.lines().count()
+            ));
         }
-        println!("scene text ({} lines)", m.scene_text.lines().count());
-    } else {
-        println!("metadata   none");
+        None => line("metadata   none".into()),
     }
-    Ok(())
+    print(out.trim_end())?;
+    damaged()
 }
 
+/// The recorded schedule, one line per set in run order, system names shortened.
+fn schedule_lines(m: &RecordingMetadata) -> Vec<String> {
+    let order = [
+        "Prepare",
+        "Field",
+        "Dipole",
+        "Contact",
+        "Wall",
+        "Fluid",
+        "Custom",
+        "Accumulate",
+        "Mobility",
+        "Integrate",
+        "Constraints",
+        "Settle",
+        "WriteBack",
+        "Flags",
+        "Clock",
+        "Observe",
+        "Record",
+    ];
+    let rank = |s: &str| {
+        order
+            .iter()
+            .position(|o| s.starts_with(o))
+            .unwrap_or(order.len())
+    };
+    let mut sets: Vec<_> = m.schedule.iter().collect();
+    sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
+    sets.into_iter()
+        .map(|(set, systems)| {
+            let short: Vec<&str> = systems
+                .iter()
+                .map(|s| s.rsplit("::").next().unwrap_or(s))
+                .collect();
+            format!("  {set:<12} {}", short.join(", "))
+        })
+        .collect()
+}
+
+/// `magsep replay`: the summary of the recording's complete frames; a damaged file is
+/// replayed up to the damage, with a warning on stderr.
 pub fn replay(ext: &Extensions, path: &Path) -> Result<(), CliError> {
-    let (summary, _) = replay_with(path, &ext.registry).map_err(|e| replay_error(path, e))?;
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&summary).unwrap_or_default()
-    );
-    Ok(())
+    let (summary, rec) = replay_with(path, &ext.registry).map_err(|e| replay_error(path, e))?;
+    if let Some(d) = &rec.damaged {
+        eprint(format!(
+            "warning: {} is damaged: {d}; replayed its {} complete frames",
+            path.display(),
+            rec.frames.len()
+        ));
+    }
+    print(serde_json::to_string_pretty(&summary).unwrap_or_default())
 }
 
 fn replay_error(path: &Path, e: ReplayError) -> CliError {
@@ -125,12 +232,30 @@ fn replay_error(path: &Path, e: ReplayError) -> CliError {
     }
 }
 
+/// `magsep replay --resume`: `--record` is checked first against the recording and the files
+/// its scene names; the consistency of scene and frame is checked by [`crate::replay::resume`]
+/// before the particles are spawned.
 pub fn resume(
     ext: &Extensions,
     path: &Path,
     record: Option<std::path::PathBuf>,
     quiet: bool,
+    force: bool,
 ) -> Result<(), CliError> {
+    if let Some(out) = &record {
+        let mut inputs = vec![Input::new("recording being resumed", path)];
+        // the summary section (or a scan) gives the recorded scene without reading frames
+        if let Ok(reader) = RecordingReader::open(path)
+            && let Some(m) = reader.metadata()
+        {
+            inputs.extend(
+                named_inputs(&m.scene_text)
+                    .into_iter()
+                    .map(|p| Input::new("recording named in the recorded scene", p)),
+            );
+        }
+        check_file("--record", out, &inputs, force)?;
+    }
     let bar = if quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -146,9 +271,5 @@ pub fn resume(
     })
     .map_err(|e| replay_error(path, e))?;
     bar.finish_and_clear();
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&summary).unwrap_or_default()
-    );
-    Ok(())
+    print(serde_json::to_string_pretty(&summary).unwrap_or_default())
 }

@@ -1,7 +1,8 @@
 //! The `magsep` command line (clap), also for a user's own binary: [`main_with`] gives it
 //! `run`, `validate`, `info`, `replay` (and the rest) with its own pipelines and plugins.
 //! Each command returns `Result<(), CliError>`; the error's code is the process exit code
-//! (0 ok, 2 bad input, 1 runtime failure).
+//! (0 ok, 2 bad input, 1 runtime failure). Output paths are checked before anything runs,
+//! and standard output is written without panicking (module `output`).
 //!
 //! ```no_run
 //! use magsep::cli::{Extensions, main_with};
@@ -23,9 +24,11 @@ use clap::{Parser, Subcommand};
 
 mod field;
 mod info;
+mod output;
 mod run;
 
-/// A CLI failure with its exit code (2 bad input, 1 runtime failure).
+/// A CLI failure with its exit code (2 bad input, 1 runtime failure). An empty message is
+/// not printed (a closed standard output ends the command quietly).
 #[derive(Debug)]
 pub struct CliError {
     /// Exit code.
@@ -77,13 +80,16 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores; at most 1024).
         #[arg(long)]
         threads: Option<usize>,
         /// Memory budget [GiB] the scene's estimated memory must fit (default: 16 GiB or
         /// 3/4 of the machine's memory, whichever is smaller; or MAGSEP_MEMORY_BUDGET).
         #[arg(long, value_name = "GiB")]
         memory_budget: Option<f64>,
+        /// Overwrite an existing --record file (never an input of the run).
+        #[arg(long)]
+        force: bool,
     },
     /// Validate a scene: exit 0 if valid, 2 with every error (and its key path) if not.
     Validate {
@@ -115,6 +121,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Overwrite an existing --record file (never the recording being resumed).
+        #[arg(long)]
+        force: bool,
     },
     /// Magnetic field of a scene's fibres: CSV at points, or a map in a plane.
     ///
@@ -149,9 +158,12 @@ enum Command {
         /// Capture cut-off force [N] (thesis: 0.5e-15 N).
         #[arg(long, default_value_t = 0.5e-15)]
         cutoff: f64,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores; at most 1024).
         #[arg(long)]
         threads: Option<usize>,
+        /// Overwrite an existing --out file (never an input).
+        #[arg(long)]
+        force: bool,
     },
     /// Benchmarks (`magsep bench packing`, `magsep bench particle-fluid --json`).
     Bench {
@@ -227,7 +239,19 @@ pub fn main_with(ext: Extensions) -> i32 {
             quiet,
             threads,
             memory_budget,
-        } => run::run(&ext, &scene, record, seed, quiet, threads, memory_budget),
+            force,
+        } => run::run(
+            &ext,
+            run::RunArgs {
+                scene,
+                record,
+                seed,
+                quiet,
+                threads,
+                force,
+                memory_budget,
+            },
+        ),
         Command::Validate {
             scene,
             memory_budget,
@@ -243,8 +267,9 @@ pub fn main_with(ext: Extensions) -> i32 {
             moment,
             cutoff,
             threads,
-        } => run::set_threads(threads).and_then(|_| {
-            field::field(field::FieldArgs {
+            force,
+        } => field::field(
+            field::FieldArgs {
                 scene,
                 points,
                 gradient,
@@ -254,17 +279,20 @@ pub fn main_with(ext: Extensions) -> i32 {
                 resolution,
                 moment,
                 cutoff,
-            })
-        }),
+                force,
+            },
+            threads,
+        ),
         Command::Info { recording, json } => info::info(&recording, json),
         Command::Replay {
             recording,
             resume,
             record,
             quiet,
+            force,
         } => {
             if resume {
-                info::resume(&ext, &recording, record, quiet)
+                info::resume(&ext, &recording, record, quiet, force)
             } else {
                 info::replay(&ext, &recording)
             }
@@ -272,14 +300,15 @@ pub fn main_with(ext: Extensions) -> i32 {
         Command::Bench { what, json, quick } => {
             crate::studies::bench::bench(what, json, quick).map_err(to_cli)
         }
-        Command::Chart { what, out, quick } => {
-            crate::studies::bench::chart(what, &out, quick).map_err(to_cli)
-        }
+        Command::Chart { what, out, quick } => output::check_dir("--out", &out)
+            .and_then(|()| crate::studies::bench::chart(what, &out, quick).map_err(to_cli)),
     };
     match result {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {}", e.message);
+            if !e.message.is_empty() {
+                output::eprint(format!("error: {}", e.message));
+            }
             e.code
         }
     }
@@ -289,5 +318,6 @@ fn to_cli(e: crate::studies::bench::BenchError) -> CliError {
     match e {
         crate::studies::bench::BenchError::Input(m) => CliError::input(m),
         crate::studies::bench::BenchError::Runtime(m) => CliError::runtime(m),
+        crate::studies::bench::BenchError::Stdout(e) => output::stdout_error(e),
     }
 }

@@ -2,18 +2,27 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
-use crate::scene::{Progress, RunOptions, Scene, load_scene};
+use crate::scene::{Progress, RunOptions, Scene, parse_scene};
 use crate::sim::{SimError, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::output::{Input, check_file, print};
 use super::{CliError, Extensions};
 
-/// Set the worker thread count of rayon (kernels) for this process.
+/// Most worker threads `--threads` accepts: more than any machine has cores, and cheap to
+/// refuse (asking for 100000 threads once spent 10-16 s spawning them before failing).
+pub const MAX_THREADS: usize = 1024;
+
+/// Set the worker thread count of rayon (kernels) for this process; `--threads` must be in
+/// 1..=[`MAX_THREADS`] (else bad input, exit 2).
 pub fn set_threads(threads: Option<usize>) -> Result<bool, CliError> {
     if let Some(n) = threads {
-        if n == 0 {
-            return Err(CliError::input("--threads must be >= 1"));
+        if n == 0 || n > MAX_THREADS {
+            return Err(CliError::input(format!(
+                "--threads must be in 1..={MAX_THREADS}, got {n}"
+            )));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -24,8 +33,26 @@ pub fn set_threads(threads: Option<usize>) -> Result<bool, CliError> {
     Ok(false)
 }
 
-fn load(ext: &Extensions, path: &Path) -> Result<Scene, CliError> {
-    load_scene(path, &ext.registry)
+/// The text of the scene file at `path` (a regular file of at most 16 MiB).
+pub fn scene_text(path: &Path) -> Result<String, CliError> {
+    read_scene_text(path)
+        .map_err(|e| CliError::input(format!("{} is invalid:\n(file): {e}", path.display())))
+}
+
+/// The scene file at `path` and the files it names, as inputs no output may overwrite.
+pub fn scene_inputs(path: &Path, text: &str) -> Vec<Input> {
+    let mut inputs = vec![Input::new("scene", path)];
+    inputs.extend(
+        named_inputs(text)
+            .into_iter()
+            .map(|p| Input::new("recording named in the scene", p)),
+    );
+    inputs
+}
+
+/// Parse the scene text `text` of the file `path`.
+pub fn parse(ext: &Extensions, path: &Path, text: &str) -> Result<Scene, CliError> {
+    parse_scene(text, &ext.registry)
         .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))
 }
 
@@ -42,22 +69,18 @@ fn memory(
 }
 
 pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Result<(), CliError> {
-    let scene = load(ext, path)?;
+    let scene = parse(ext, path, &scene_text(path)?)?;
     let (estimate, budget) = memory(&scene, path, budget_gib)?;
-    println!(
-        "{}",
-        serde_json::json!({
-            "valid": true,
-            "scene": path.display().to_string(),
-            "pipeline": scene.pipeline_name(),
-            "particles": scene.total_particles(),
-            "fibres": scene.fibres.len(),
-            "memory_estimate_bytes": estimate.bytes.round() as u64,
-            "memory_estimate": estimate.detail,
-            "memory_budget_bytes": budget,
-        })
-    );
-    Ok(())
+    print(serde_json::json!({
+        "valid": true,
+        "scene": path.display().to_string(),
+        "pipeline": scene.pipeline_name(),
+        "particles": scene.total_particles(),
+        "fibres": scene.fibres.len(),
+        "memory_estimate_bytes": estimate.bytes.round() as u64,
+        "memory_estimate": estimate.detail,
+        "memory_budget_bytes": budget,
+    }))
 }
 
 /// A progress bar on stderr (a spinner until the total is known).
@@ -81,18 +104,36 @@ impl Progress for Bar {
     }
 }
 
-pub fn run(
-    ext: &Extensions,
-    path: &Path,
-    record: Option<PathBuf>,
-    seed: Option<u64>,
-    quiet: bool,
-    threads: Option<usize>,
-    budget_gib: Option<f64>,
-) -> Result<(), CliError> {
+/// The options of `magsep run`.
+pub struct RunArgs {
+    pub scene: PathBuf,
+    pub record: Option<PathBuf>,
+    pub seed: Option<u64>,
+    pub quiet: bool,
+    pub threads: Option<usize>,
+    pub force: bool,
+    pub memory_budget: Option<f64>,
+}
+
+/// `magsep run`: the output path is checked before anything runs (see `output`).
+pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
+    let RunArgs {
+        scene: path,
+        record,
+        seed,
+        quiet,
+        threads,
+        force,
+        memory_budget,
+    } = args;
+    let path = path.as_path();
+    let text = scene_text(path)?;
+    if let Some(out) = &record {
+        check_file("--record", out, &scene_inputs(path, &text), force)?;
+    }
     let single = set_threads(threads)?;
-    let scene = load(ext, path)?;
-    memory(&scene, path, budget_gib)?;
+    let scene = parse(ext, path, &text)?;
+    memory(&scene, path, memory_budget)?;
     let options = RunOptions {
         seed,
         record,
@@ -116,10 +157,7 @@ pub fn run(
         e => CliError::runtime(e.to_string()),
     })?;
     bar.finish_and_clear();
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&summary).unwrap_or_default()
-    );
+    print(serde_json::to_string_pretty(&summary).unwrap_or_default())?;
     if let Some(why) = scene.pipeline.as_ref().and_then(|p| p.failure(&summary)) {
         return Err(CliError::runtime(why));
     }

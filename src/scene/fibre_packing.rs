@@ -18,7 +18,6 @@
 //! not replicated.
 
 use glam::DVec3;
-use magsep_plugins::record::read_recording;
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
@@ -61,17 +60,15 @@ pub(super) fn expand(
         ));
         return Vec::new();
     }
-    let rec = match read_recording(std::path::Path::new(&spec.recording)) {
+    // a regular file, size-capped, streamed; errors never quote its bytes (crate::input)
+    let last = match crate::input::read_named_recording(std::path::Path::new(&spec.recording)) {
         Ok(r) => r,
         Err(e) => {
-            errors.push(SceneError::new(
-                path,
-                format!("cannot read {}: {e}", spec.recording),
-            ));
+            errors.push(SceneError::new(path, e));
             return Vec::new();
         }
     };
-    let Some(frame) = rec.frames.last() else {
+    let Some(frame) = last.frame.as_ref() else {
         errors.push(SceneError::new(
             path,
             format!("{} holds no complete frame", spec.recording),

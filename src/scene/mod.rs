@@ -113,12 +113,9 @@ pub fn parse_scene(text: &str, registry: &Registry) -> Result<Scene, SceneErrors
 /// # Errors
 /// [`SceneErrors`]; an unreadable file is one error with path `(file)`.
 pub fn load_scene(path: &Path, registry: &Registry) -> Result<Scene, SceneErrors> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        SceneErrors(vec![SceneError::new(
-            "(file)",
-            format!("cannot read {}: {e}", path.display()),
-        )])
-    })?;
+    // a regular file of at most 16 MiB (crate::input)
+    let text = crate::input::read_scene_text(path)
+        .map_err(|e| SceneErrors(vec![SceneError::new("(file)", e)]))?;
     parse_scene(&text, registry)
 }
 

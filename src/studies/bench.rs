@@ -32,6 +32,9 @@ pub enum BenchError {
     /// Failure while running (exit 1).
     #[error("{0}")]
     Runtime(String),
+    /// Standard output is closed or full (exit 1; quietly for a closed pipe).
+    #[error("cannot write to standard output: {0}")]
+    Stdout(std::io::Error),
 }
 
 /// Result of one packing run on dense data.
@@ -142,10 +145,26 @@ fn loose_spheres(
     Ok((state, list))
 }
 
+/// Writes `text` and a newline to standard output and flushes it: a closed or full standard
+/// output is [`BenchError::Stdout`], never a panic.
+///
+/// # Errors
+/// [`BenchError::Stdout`].
+pub fn say(text: impl std::fmt::Display) -> Result<(), BenchError> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{text}")
+        .and_then(|()| out.flush())
+        .map_err(BenchError::Stdout)
+}
+
 /// Print one measurement (JSON line or a table row) and keep it.
-pub(crate) fn emit(rows: &mut Vec<Value>, as_json: bool, row: Value) {
+///
+/// # Errors
+/// [`BenchError::Stdout`].
+pub(crate) fn emit(rows: &mut Vec<Value>, as_json: bool, row: Value) -> Result<(), BenchError> {
     if as_json {
-        println!("{row}");
+        say(&row)?;
     } else {
         let name = row["name"].as_str().unwrap_or("");
         let figures: Vec<String> = row
@@ -157,9 +176,10 @@ pub(crate) fn emit(rows: &mut Vec<Value>, as_json: bool, row: Value) {
                     .collect()
             })
             .unwrap_or_default();
-        println!("{name:<32} {}", figures.join("  "));
+        say(format!("{name:<32} {}", figures.join("  ")))?;
     }
     rows.push(row);
+    Ok(())
 }
 
 /// Least-squares slope of log(y) against log(x).
@@ -247,7 +267,7 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         &mut rows,
         as_json,
         json!({"name": "packing_spheres_to_jamming", "particles": n_small, "threads": 1, "wall_time_s": r.wall_time_s, "attempts_per_s": r.attempts as f64 / r.wall_time_s, "packing_fraction": r.packing_fraction, "steps": r.steps}),
-    );
+    )?;
     // 2. rods of aspect ratio 5 to the jammed state
     let rod = Shape::Spherocylinder {
         radius: 0.5,
@@ -258,7 +278,7 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         &mut rows,
         as_json,
         json!({"name": "packing_rods_aspect5_to_jamming", "particles": n_small, "threads": 1, "wall_time_s": r.wall_time_s, "attempts_per_s": r.attempts as f64 / r.wall_time_s, "packing_fraction": r.packing_fraction, "steps": r.steps}),
-    );
+    )?;
     // 3. many spheres to phi = 0.55 (the dense end costs most; this bounds the run time)
     let cfg_l = PackingConfig::defaults_for(n_large, 1.0);
     let r = packing_run(n_large, Shape::Sphere { radius: 0.5 }, &cfg_l, 1, 0.55)?;
@@ -266,7 +286,7 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         &mut rows,
         as_json,
         json!({"name": "packing_spheres_to_phi_0.55", "particles": n_large, "threads": 1, "wall_time_s": r.wall_time_s, "attempts_per_s": r.attempts as f64 / r.wall_time_s, "packing_fraction": r.packing_fraction, "steps": r.steps}),
-    );
+    )?;
     // 4. cost of one sweep against N (phi = 0.35, overlaps created by a 1 % compression)
     let sizes: &[usize] = if quick {
         &[250, 1000, 4000]
@@ -303,13 +323,13 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
             &mut rows,
             as_json,
             json!({"name": "packing_sweep_cost", "particles": n, "threads": 1, "fire_iteration_s": per_force, "overlap_scan_s": per_scan, "neighbour_build_s": per_build}),
-        );
+        )?;
     }
     emit(
         &mut rows,
         as_json,
         json!({"name": "packing_sweep_cost_exponent", "threads": 1, "fire_iteration_exponent": log_slope(&fire_pts), "overlap_scan_exponent": log_slope(&scan_pts), "sizes": sizes}),
-    );
+    )?;
     let _ = threads;
     Ok(())
 }
@@ -338,16 +358,13 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
             let study = crate::studies::sq_study::run_sq_contact_study(quick);
             let summary = crate::studies::sq_study::write_sq_study(&study, out)
                 .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
-            println!("{summary}");
-            return Ok(());
+            return say(summary);
         }
         ChartKind::Field => {
             let rows = crate::studies::bench_field::chart_field(out, quick)?;
-            println!(
-                "{}",
-                json!({"charts": [out.join("field_error_vs_cost.svg").display().to_string()], "points": rows})
+            return say(
+                json!({"charts": [out.join("field_error_vs_cost.svg").display().to_string()], "points": rows}),
             );
-            return Ok(());
         }
         ChartKind::Packing => {}
     }
@@ -502,11 +519,7 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         );
     let p2 = out.join("packing_aspect_ratio.svg");
     write_svg(&p2, &fig.to_svg(560.0, 420.0)).map_err(|e| BenchError::Runtime(e.to_string()))?;
-    println!(
-        "{}",
-        json!({"charts": [p1.display().to_string(), p2.display().to_string()], "runs": summary})
-    );
-    Ok(())
+    say(json!({"charts": [p1.display().to_string(), p2.display().to_string()], "runs": summary}))
 }
 
 #[cfg(test)]

@@ -206,7 +206,7 @@ pub fn bench_brownian_with(
                     "lammps_reference_per_core": LAMMPS_REFERENCE_PER_CORE,
                     "load_average_1min": load_average(),
                 }),
-            );
+            )?;
             last_positions = x;
         }
     }
@@ -225,7 +225,7 @@ pub fn bench_brownian_with(
             "mean_neighbours_end": mean_neighbours(&last_positions, rc),
             "bulk_expectation": PIPELINE_VOLUME_FRACTION * DIPOLE_CUTOFF.powi(3),
         }),
-    );
+    )?;
     // (b) cost of the mobility work of one step
     let threads = rayon::current_num_threads();
     for &method in &sizes.hi_methods {
@@ -260,7 +260,7 @@ pub fn bench_brownian_with(
                     "steps_per_s": 1.0 / t.total_s,
                     "krylov_iterations": t.krylov_iterations,
                 }),
-            );
+            )?;
         }
         if pts.len() >= 2 {
             emit(
@@ -274,7 +274,7 @@ pub fn bench_brownian_with(
                     "sizes": sizes.hi_sizes,
                     "exponent": log_slope(&pts),
                 }),
-            );
+            )?;
         }
     }
     Ok(rows)
@@ -292,8 +292,7 @@ pub fn chart_brownian_cost(out: &Path, quick: bool) -> Result<(), BenchError> {
         CostChartSizes::full()
     };
     let summary = chart_brownian_cost_with(out, &sizes)?;
-    println!("{summary}");
-    Ok(())
+    crate::studies::bench::say(summary)
 }
 
 /// The cost chart at explicit sizes; returns the summary printed by [`chart_brownian_cost`].

@@ -86,7 +86,7 @@ pub fn bench_field(as_json: bool, quick: bool) -> Result<(), BenchError> {
                 &mut rows,
                 as_json,
                 json!({"name": "field", "case": case, "threads": threads, "points": n, "points_per_s": pps}),
-            );
+            )?;
         }
         let grad = |p: DVec3| src.field_gradient(p, EXACT).grad_b.x_axis.x;
         let pps = rate(&points[..n / 4], 1, reps, &grad);
@@ -94,7 +94,7 @@ pub fn bench_field(as_json: bool, quick: bool) -> Result<(), BenchError> {
             &mut rows,
             as_json,
             json!({"name": "field_gradient", "case": case, "threads": 1, "points": n / 4, "points_per_s": pps}),
-        );
+        )?;
     }
     Ok(())
 }

@@ -418,9 +418,5 @@ pub fn chart_brownian(out: &Path, quick: bool) -> Result<(), BenchError> {
     write_svg(&path, &fig_d.to_svg(720.0, 440.0)).map_err(|e| io_err(&path, e))?;
 
     report["wall_time_s"] = json!(started.elapsed().as_secs_f64());
-    println!(
-        "{}",
-        serde_json::to_string_pretty(&report).unwrap_or_default()
-    );
-    Ok(())
+    crate::studies::bench::say(serde_json::to_string_pretty(&report).unwrap_or_default())
 }

@@ -132,6 +132,7 @@ fn record_info_replay_truncation_and_determinism() {
         "--quiet",
         "--threads",
         "1",
+        "--force",
     ]);
     assert!(o1.status.success(), "{}", stderr(&o1));
     let o2 = magsep(&[
@@ -142,6 +143,7 @@ fn record_info_replay_truncation_and_determinism() {
         "--quiet",
         "--threads",
         "2",
+        "--force",
     ]);
     assert!(o2.status.success(), "{}", stderr(&o2));
     let (s1, s2) = (json(&o1), json(&o2));

@@ -93,6 +93,7 @@ fn field_map_and_capture_contour() {
         "8.7e-17",
         "--out",
         out.to_str().unwrap(),
+        "--force",
     ]);
     assert_eq!(
         o.status.code(),

@@ -1,6 +1,7 @@
 //! Integration tests, one binary: every module below was a test file of its own. One
 //! binary links the crate once, which keeps CI's build time and disk use down.
 
+mod bad_recordings;
 mod bad_scenes;
 mod bench_brownian;
 mod brownian_capture;
@@ -13,6 +14,7 @@ mod common;
 mod field_reference;
 mod fluid_charts;
 mod memory_budget;
+mod outputs;
 mod packing_validation;
 mod packing_walls;
 mod particle_fluid;

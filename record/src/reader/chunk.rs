@@ -5,7 +5,17 @@ use mcap::records::op;
 use std::io::Read;
 use std::ops::Range;
 
-/// Limits of the reader against damaged or crafted length fields.
+/// Limits of the reader against damaged or crafted length fields and compression bombs.
+///
+/// The defaults bound the memory one chunk may take to [`ReaderLimits::max_chunk_bytes`]
+/// (1 GiB) and to [`ReaderLimits::max_compression_ratio`] (64) times its compressed size
+/// (chunks that decompress to at most [`RATIO_FREE_BYTES`], 1 MiB, are exempt from the ratio).
+/// Real recordings stay far inside both: the recordings of the shipped scenes compress by
+/// 1.4-4.2 (largest chunk ratio measured: 4.2, see `recordings/README.md`), and a frame is
+/// about 470 bytes per particle before compression, so a 1 GiB chunk is a frame of more than
+/// 2 million particles; [`RecordingWriter`](crate::RecordingWriter) refuses to write a frame
+/// that the default reader would refuse to read. A zstd bomb of 131 KB thus costs at most
+/// 8.4 MB instead of gigabytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ReaderLimits {
     /// Largest record read into memory (bytes): a chunk, a message outside chunks, a metadata
@@ -16,23 +26,34 @@ pub struct ReaderLimits {
     /// this before decompressing, and decompression stops as soon as the output would exceed
     /// the declared size.
     pub max_chunk_bytes: u64,
+    /// Largest ratio of a chunk's declared uncompressed size to its compressed size, for
+    /// chunks larger than [`RATIO_FREE_BYTES`] uncompressed.
+    pub max_compression_ratio: u64,
 }
 
 impl Default for ReaderLimits {
-    /// 1 GiB records, 1 GiB decompressed chunks.
+    /// 1 GiB records, 1 GiB decompressed chunks, compression ratio at most 64.
     fn default() -> Self {
         Self {
             max_record_bytes: 1 << 30,
-            max_chunk_bytes: 1 << 30,
+            max_chunk_bytes: MAX_CHUNK_BYTES,
+            max_compression_ratio: 64,
         }
     }
 }
 
-/// Bound on zstd's expansion ratio (an RLE block turns 4 bytes into at most 128 KiB).
-const MAX_ZSTD_RATIO: u64 = 1 << 16;
+/// Default [`ReaderLimits::max_chunk_bytes`] (1 GiB); the writer refuses larger frames.
+pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
+
+/// Chunks that decompress to at most this many bytes (1 MiB) are exempt from
+/// [`ReaderLimits::max_compression_ratio`]: small chunks (schemas, a frame of few particles)
+/// may compress well without costing memory.
+pub const RATIO_FREE_BYTES: u64 = 1 << 20;
 
 /// Decompresses the chunk record body `body` and checks its CRC; returns the records it holds.
-/// Memory: at most the declared uncompressed size (itself at most `limits.max_chunk_bytes`).
+/// Memory: the declared uncompressed size, which is checked first against
+/// `limits.max_chunk_bytes` and against `limits.max_compression_ratio` times the compressed
+/// size; decompression never writes past it.
 pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, String> {
     let mut c = Cursor::new(body);
     c.u64("message start time")?;
@@ -56,32 +77,18 @@ pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, 
     let data = c.rest();
     let out = match compression.as_str() {
         "zstd" => {
-            if uncompressed > compressed.saturating_mul(MAX_ZSTD_RATIO) {
+            let allowed = compressed
+                .saturating_mul(limits.max_compression_ratio)
+                .max(RATIO_FREE_BYTES);
+            if uncompressed > allowed {
                 return Err(format!(
-                    "uncompressed size {uncompressed} is impossible for {compressed} bytes of \
-                     zstd data"
+                    "uncompressed size {uncompressed} for {compressed} bytes of zstd data is a \
+                     compression ratio above the reader's limit of {}:1 (a compression bomb or \
+                     a damaged size)",
+                    limits.max_compression_ratio
                 ));
             }
-            let decoder =
-                zstd::stream::read::Decoder::new(data).map_err(|e| format!("zstd decoder: {e}"))?;
-            // Never more than declared + 1 bytes: one more means the declared size is wrong.
-            let mut out = Vec::with_capacity(uncompressed.min(1 << 24) as usize);
-            decoder
-                .take(uncompressed + 1)
-                .read_to_end(&mut out)
-                .map_err(|e| format!("zstd decompression failed: {e}"))?;
-            if out.len() as u64 != uncompressed {
-                return Err(format!(
-                    "zstd data decompresses to {}{} bytes, but the chunk declares {uncompressed}",
-                    out.len(),
-                    if out.len() as u64 > uncompressed {
-                        " or more"
-                    } else {
-                        ""
-                    }
-                ));
-            }
-            out
+            inflate(data, uncompressed)?
         }
         "" => {
             if uncompressed != compressed {
@@ -94,7 +101,8 @@ pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, 
         }
         other => {
             return Err(format!(
-                "compression {other:?} is not supported; expected \"zstd\" or \"\""
+                "compression {:?} is not supported; expected \"zstd\" or \"\"",
+                crate::parse::clip(other)
             ));
         }
     };
@@ -108,6 +116,41 @@ pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, 
         }
     }
     Ok(out)
+}
+
+/// Decompresses the zstd `data` into exactly `size` bytes (checked by the caller): one buffer
+/// of that size, allocated fallibly, and an error if the data gives fewer or more bytes.
+fn inflate(data: &[u8], size: u64) -> Result<Vec<u8>, String> {
+    let n = usize::try_from(size).map_err(|_| format!("uncompressed size {size} is too large"))?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(n)
+        .map_err(|_| format!("cannot allocate {size} bytes for the decompressed chunk"))?;
+    out.resize(n, 0);
+    let mut decoder =
+        zstd::stream::read::Decoder::new(data).map_err(|e| format!("zstd decoder: {e}"))?;
+    let mut filled = 0;
+    while filled < n {
+        match decoder.read(&mut out[filled..]) {
+            Ok(0) => break,
+            Ok(k) => filled += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(format!("zstd decompression failed: {e}")),
+        }
+    }
+    if filled < n {
+        return Err(format!(
+            "zstd data decompresses to {filled} bytes, but the chunk declares {size}"
+        ));
+    }
+    // One more byte means the declared size is wrong (never decompressed further).
+    let mut probe = [0u8; 1];
+    match decoder.read(&mut probe) {
+        Ok(0) => Ok(out),
+        Ok(_) => Err(format!(
+            "zstd data decompresses to more than the {size} bytes the chunk declares"
+        )),
+        Err(e) => Err(format!("zstd decompression failed: {e}")),
+    }
 }
 
 /// Splits the content of a chunk into records `(opcode, body range)`; only schema, channel,

@@ -2,7 +2,7 @@
 //! and where the messages are (chunks, or message records outside chunks).
 
 use crate::meta::parse_metadata;
-use crate::parse::Cursor;
+use crate::parse::{Cursor, clip};
 use crate::{METADATA_NAME, RecordError, RecordingMetadata, STATE_TOPIC, SUMMARY_METADATA_NAME};
 use std::collections::{BTreeMap, HashMap};
 
@@ -125,6 +125,8 @@ pub(crate) struct Layout {
     /// Messages on `/state` found so far (complete frames, for truncation messages).
     pub state_messages: u64,
     pub end: End,
+    /// Bytes after the closing magic: (offset of the first, count). Not part of the recording.
+    pub trailing: Option<(u64, u64)>,
     /// Whether the layout comes from the summary section (else from a linear scan).
     pub indexed: bool,
 }
@@ -138,7 +140,8 @@ impl Layout {
         let data = c.bytes_u32("schema data")?.to_vec();
         if id == 0 {
             return Err(RecErr::Corrupt(format!(
-                "schema {name:?} has the reserved id 0"
+                "schema {:?} has the reserved id 0",
+                clip(&name)
             )));
         }
         self.schemas.insert(
@@ -161,8 +164,9 @@ impl Layout {
         c.string_map("channel metadata")?;
         if schema_id != 0 && !self.schemas.contains_key(&schema_id) {
             return Err(RecErr::Corrupt(format!(
-                "channel {topic:?} refers to schema id {schema_id}, which no earlier schema \
-                 record defines"
+                "channel {:?} refers to schema id {schema_id}, which no earlier schema \
+                 record defines",
+                clip(&topic)
             )));
         }
         // A repeated definition keeps counting.
@@ -203,7 +207,7 @@ impl Layout {
             self.metadata = Some(parse_metadata(&entries).map_err(RecErr::Decode)?);
         } else if name == SUMMARY_METADATA_NAME {
             let summary = entries.get("summary").ok_or_else(|| {
-                RecErr::Decode(format!("metadata {name:?} lacks key \"summary\""))
+                RecErr::Decode(format!("metadata {:?} lacks key \"summary\"", clip(&name)))
             })?;
             self.summary_json = Some(summary.clone());
         }

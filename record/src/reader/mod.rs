@@ -8,9 +8,11 @@ mod source;
 mod stream;
 mod summary;
 
-pub use chunk::ReaderLimits;
+pub use chunk::{MAX_CHUNK_BYTES, RATIO_FREE_BYTES, ReaderLimits};
 pub use layout::MetadataRecord;
-pub use stream::{Frames, Messages, RawMessage, ReadMode, RecordingReader, SchemaInfo};
+pub use stream::{
+    Frames, Messages, RawMessage, ReadMode, RecordingReader, SchemaInfo, open_regular,
+};
 
 use crate::{ParticleFrame, RecordError, RecordingMetadata};
 use std::io::{Read, Seek};
@@ -50,6 +52,12 @@ pub struct Recording {
     /// before its footer (process killed; the message gives the byte where the file ends and
     /// the start of the incomplete record), or a damaged record follows the frames read.
     pub truncated: Option<String>,
+    /// `None` unless the file is damaged: a corrupt or undecodable record stopped the reading
+    /// (also given in [`truncated`](Self::truncated)), or bytes follow the closing magic
+    /// ([`trailing_bytes`](Self::trailing_bytes)). Frames before the damage are read.
+    pub damaged: Option<String>,
+    /// Bytes after the closing magic (0 for an intact or a truncated file).
+    pub trailing_bytes: u64,
     /// Size of the file (bytes).
     pub file_bytes: u64,
 }
@@ -78,6 +86,58 @@ pub fn read_recording_bytes(data: &[u8]) -> Result<Recording, RecordError> {
     collect(reader)
 }
 
+/// The last complete `/state` frame of a recording, from [`read_last_frame`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LastFrame {
+    /// The last complete frame (`None`: the file holds none).
+    pub frame: Option<ParticleFrame>,
+    /// Number of complete frames read.
+    pub frames: u64,
+    /// As [`Recording::truncated`].
+    pub truncated: Option<String>,
+    /// As [`Recording::damaged`].
+    pub damaged: Option<String>,
+}
+
+/// The last complete frame of the recording at `path`, streamed: at most one chunk and two
+/// frames are in memory, whatever the file's size ([`ReadMode::Indexed`], default limits).
+/// Errors as [`read_recording`].
+pub fn read_last_frame(path: &Path) -> Result<LastFrame, RecordError> {
+    let mut reader = RecordingReader::open(path)?;
+    let mut last = LastFrame::default();
+    let mut failure = None;
+    for frame in reader.frames() {
+        match frame {
+            Ok(f) => {
+                last.frame = Some(f);
+                last.frames += 1;
+            }
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        }
+    }
+    match failure {
+        Some(e) if last.frames == 0 => return Err(e),
+        Some(e) => {
+            let msg = format!(
+                "{e}; reading stopped there: {} complete frames read",
+                last.frames
+            );
+            last.truncated = Some(msg.clone());
+            last.damaged = Some(msg);
+        }
+        None => {
+            last.truncated = reader.truncated().map(str::to_string);
+            last.damaged = reader
+                .trailing_bytes()
+                .map(|(at, count)| trailing_message(at, count));
+        }
+    }
+    Ok(last)
+}
+
 fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, RecordError> {
     let mut frames = Vec::new();
     let mut failure = None;
@@ -91,12 +151,17 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
         }
     }
     let n = frames.len();
-    let truncated = match failure {
-        None => reader.truncated().map(str::to_string),
+    let trailing = reader.trailing_bytes();
+    let (truncated, damaged) = match failure {
+        None => (
+            reader.truncated().map(str::to_string),
+            trailing.map(|(at, count)| trailing_message(at, count)),
+        ),
         Some(e) if n == 0 => return Err(e),
-        Some(e) => Some(format!(
-            "{e}; reading stopped there: {n} complete frames read"
-        )),
+        Some(e) => {
+            let msg = format!("{e}; reading stopped there: {n} complete frames read");
+            (Some(msg.clone()), Some(msg))
+        }
     };
     Ok(Recording {
         metadata: reader.metadata().cloned(),
@@ -105,6 +170,17 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
         channels: reader.channels(),
         metadata_records: reader.metadata_records().to_vec(),
         truncated,
+        damaged,
+        trailing_bytes: trailing.map_or(0, |t| t.1),
         file_bytes: reader.file_bytes(),
     })
+}
+
+/// The damage message of `count` bytes after the closing magic, from byte `at`.
+pub fn trailing_message(at: u64, count: u64) -> String {
+    format!(
+        "{count} trailing bytes after the footer (bytes {at}..{}): not part of the recording; \
+         the records before them are intact",
+        at + count
+    )
 }

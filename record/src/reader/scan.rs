@@ -115,11 +115,20 @@ impl<R: Read + Seek> Scan<'_, R> {
             return Err(self.truncated("inside the 8-byte MCAP magic (no footer)".into()));
         }
         if !head.starts_with(magic) {
+            // The file's own bytes are never quoted: it may be any file (a scene naming
+            // `/etc/passwd` as a recording must not reveal it).
             return Err(Stop::Failed(RecordError::NotMcap {
                 detail: format!(
-                    "the file starts with bytes [{}], expected the MCAP magic [{}]",
-                    hex_prefix(&head),
-                    hex_prefix(magic)
+                    "the file does not start with the MCAP magic [{}]{}",
+                    hex_prefix(magic),
+                    if head
+                        .iter()
+                        .all(|b| b.is_ascii_graphic() || b.is_ascii_whitespace())
+                    {
+                        " (it starts with text)"
+                    } else {
+                        ""
+                    }
                 ),
             }));
         }
@@ -341,11 +350,14 @@ impl<R: Read + Seek> Scan<'_, R> {
             return Err(corrupt(
                 end,
                 format!(
-                    "found bytes [{}] after the footer, expected the closing MCAP magic [{}]",
-                    hex_prefix(&tail),
+                    "the footer at byte {start} is not followed by the closing MCAP magic [{}]",
                     hex_prefix(magic)
                 ),
             ));
+        }
+        let after = end + magic.len() as u64;
+        if after < self.src.len {
+            self.layout.trailing = Some((after, self.src.len - after));
         }
         Ok(())
     }

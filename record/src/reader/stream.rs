@@ -114,12 +114,32 @@ impl RecordingReader<BufReader<File>> {
         mode: ReadMode,
         limits: ReaderLimits,
     ) -> Result<Self, RecordError> {
-        let file = File::open(path).map_err(|source| RecordError::Io {
+        let file = open_regular(path).map_err(|source| RecordError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         Self::from_reader(BufReader::new(file), path, mode, limits)
     }
+}
+
+/// Opens `path` for reading if it is a regular file (after following symbolic links):
+/// directories, devices (`/dev/zero`), FIFOs and sockets are refused before they are opened
+/// (opening a FIFO would block), and the opened file is checked again.
+pub fn open_regular(path: &Path) -> std::io::Result<File> {
+    let not_regular = || {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a directory, device, FIFO or socket)",
+        )
+    };
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(not_regular());
+    }
+    let file = File::open(path)?;
+    if !file.metadata()?.is_file() {
+        return Err(not_regular());
+    }
+    Ok(file)
 }
 
 impl<R: Read + Seek> RecordingReader<R> {
@@ -222,6 +242,13 @@ impl<R: Read + Seek> RecordingReader<R> {
             End::Failed(e) => Some(e),
             _ => None,
         }
+    }
+
+    /// Bytes after the closing magic of a complete file: `(offset, count)`. A recording
+    /// ends with its closing magic; anything after it was appended by something else, and
+    /// the file counts as damaged (the records before are read as usual).
+    pub fn trailing_bytes(&self) -> Option<(u64, u64)> {
+        self.layout.trailing
     }
 
     /// Whether the file was opened through its summary section (else by a linear scan).

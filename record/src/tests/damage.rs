@@ -162,3 +162,64 @@ fn record_fuzzed_files_never_panic() {
         "ok {ok}, flagged {flagged}, failed {failed}"
     );
 }
+
+#[test]
+fn record_bytes_after_the_closing_magic_are_damage() {
+    let frames = random_frames(31, 4, true);
+    let (_, bytes) = write_recording("trailing.mcap", &frames, true);
+    let n = bytes.len() as u64;
+    let intact = read_recording_bytes(&bytes).unwrap();
+    assert_eq!((intact.trailing_bytes, intact.damaged), (0, None));
+    let mut more = bytes.clone();
+    more.extend_from_slice(&[0u8; 100]);
+    let rec = read_recording_bytes(&more).unwrap();
+    // everything before is read; the file is damaged, not truncated
+    assert_frames_bitwise_eq(&rec.frames, &frames);
+    assert_eq!(rec.truncated, None);
+    assert_eq!(rec.trailing_bytes, 100);
+    let msg = rec.damaged.unwrap();
+    assert!(
+        msg.contains(&format!(
+            "100 trailing bytes after the footer (bytes {n}..{})",
+            n + 100
+        )),
+        "{msg}"
+    );
+    // a whole second copy appended: the indexed reader falls back to the scan, which finds it
+    let mut twice = bytes.clone();
+    twice.extend_from_slice(&bytes);
+    let path = TempFile::new("trailing-copy.mcap");
+    std::fs::write(&path, &twice).unwrap();
+    let reader = RecordingReader::open(path.as_ref()).unwrap();
+    assert_eq!(reader.trailing_bytes(), Some((n, n)));
+    let last = read_last_frame(path.as_ref()).unwrap();
+    assert_eq!(last.frames, 4);
+    assert!(
+        last.damaged
+            .unwrap()
+            .contains(&format!("{n} trailing bytes"))
+    );
+}
+
+#[test]
+fn record_inputs_must_be_regular_files_and_are_never_quoted() {
+    for path in ["/dev/zero", "/tmp"] {
+        let err = read_recording(std::path::Path::new(path)).unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+        let err = RecordingReader::open(std::path::Path::new(path)).unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+    }
+    let path = TempFile::new("passwd");
+    std::fs::write(&path, "root:x:0:0:root:/root:/bin/bash\n").unwrap();
+    let err = read_recording(path.as_ref()).unwrap_err().to_string();
+    assert!(
+        err.contains("not an MCAP file") && err.contains("text"),
+        "{err}"
+    );
+    for leak in ["root", "72 6f 6f 74", "bash"] {
+        assert!(!err.contains(leak), "{leak} in {err}");
+    }
+    // strings of a damaged file are quoted cut short
+    assert_eq!(crate::parse::clip(&"x".repeat(1000)).len(), 64 + 3);
+    assert_eq!(crate::parse::clip("short"), "short");
+}

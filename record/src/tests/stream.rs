@@ -119,16 +119,31 @@ fn record_crafted_huge_lengths_are_errors_not_allocations() {
     let (offset, detail) = corrupt_detail(read_recording_bytes(&bytes));
     assert_eq!(offset, 8 + 9 + 15);
     assert!(detail.contains("exceeds the reader's limit"), "{detail}");
-    // Within the limit but impossible for the compressed size.
+    // Within the size limit but beyond the compression ratio limit: refused before anything
+    // is allocated or decompressed.
     let bytes = crafted_chunk(1 << 29, "zstd", &zstd13, true);
     let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
-    assert!(detail.contains("impossible"), "{detail}");
+    assert!(detail.contains("compression ratio above"), "{detail}");
     // Declared smaller than the data decompresses to: decompression stops, no overrun.
     let big = zstd::bulk::compress(&vec![7u8; 1 << 20], 3).unwrap();
     let bytes = crafted_chunk(100, "zstd", &big, true);
     let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
     assert!(
-        detail.contains("or more bytes, but the chunk declares 100"),
+        detail.contains("decompresses to more than the 100 bytes"),
+        "{detail}"
+    );
+    // 1 MiB of one byte value is a ratio of thousands: allowed up to RATIO_FREE_BYTES (the
+    // chunk then fails on its content), refused one byte above it.
+    let bytes = crafted_chunk(RATIO_FREE_BYTES, "zstd", &big, true);
+    let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
+    assert!(
+        detail.contains("record #0 in the chunk declares"),
+        "{detail}"
+    );
+    let bytes = crafted_chunk(RATIO_FREE_BYTES + 1, "zstd", &big, true);
+    let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
+    assert!(
+        detail.contains("compression ratio above the reader's limit of 64:1"),
         "{detail}"
     );
     // Declared larger than it decompresses to.
@@ -159,8 +174,8 @@ fn record_crafted_huge_lengths_are_errors_not_allocations() {
     let path = TempFile::new("limits.mcap");
     std::fs::write(&path, &good).unwrap();
     let limits = ReaderLimits {
-        max_record_bytes: 1 << 30,
         max_chunk_bytes: 64,
+        ..ReaderLimits::default()
     };
     let mut reader = RecordingReader::open_with(&path, ReadMode::Linear, limits).unwrap();
     let err = reader.frames().next().unwrap().unwrap_err();

@@ -8,6 +8,7 @@ pub use channels::ChannelHandle;
 use crate::frame::{BackdropCube, FibreShape, WallShape};
 use crate::meta::metadata_entries;
 use crate::proto::{encode_state, particle_count, state_schema};
+use crate::reader::MAX_CHUNK_BYTES;
 use crate::scene::{SceneDecor, scene_update};
 use crate::{
     METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
@@ -150,7 +151,9 @@ impl RecordingWriter {
     ///
     /// `colours` gives each particle's RGBA colour (components in 0..1) in the scene, in the
     /// frame's particle order; `None` uses a default colour. Fails with
-    /// [`RecordError::InvalidInput`] if the frame's arrays (or `colours`) differ in length.
+    /// [`RecordError::InvalidInput`] if the frame's arrays (or `colours`) differ in length, or
+    /// if the frame's chunk would exceed [`MAX_CHUNK_BYTES`] (1 GiB, the readers' default
+    /// limit; about two million particles), before anything is written.
     pub fn write_frame(
         &mut self,
         frame: &ParticleFrame,
@@ -172,16 +175,27 @@ impl RecordingWriter {
         // MCAP sequence numbers are u32; wrapping after 2^32 frames is harmless.
         let sequence = self.frames_written as u32;
 
-        self.buf.clear();
-        encode_state(frame, &mut self.buf);
-        self.write_buf(self.state_channel, sequence, log_time)?;
-
-        self.buf.clear();
+        let mut scene = Vec::new();
         scene_update(frame, colours, &self.decor, log_time)
-            .encode(&mut self.buf)
+            .encode(&mut scene)
             .map_err(|e| RecordError::InvalidInput {
                 detail: format!("encoding /scene: {e}"),
             })?;
+        self.buf.clear();
+        encode_state(frame, &mut self.buf);
+        // The frame's chunk holds both messages (record and message headers: 31 bytes each).
+        let chunk = (self.buf.len() + scene.len() + 62) as u64;
+        if chunk > MAX_CHUNK_BYTES {
+            return Err(RecordError::InvalidInput {
+                detail: format!(
+                    "frame at step {} of {n} particles takes {chunk} bytes, more than the \
+                     {MAX_CHUNK_BYTES} bytes per chunk that readers accept",
+                    frame.step
+                ),
+            });
+        }
+        self.write_buf(self.state_channel, sequence, log_time)?;
+        self.buf = scene;
         self.write_buf(self.scene_channel, sequence, log_time)?;
 
         self.flush()?;

@@ -155,7 +155,7 @@ fn history_rows(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(),
                         as_json,
                         json!({"name": name, "threads": 1, "particles": particles, "n": n,
                                "skipped": format!("{} stored intervals exceed the {MAX_STORED} memory cap", particles * n)}),
-                    );
+                    )?;
                     continue;
                 }
                 let t = history_step_time(kernel, n, particles, budget, min_time)?;
@@ -167,7 +167,7 @@ fn history_rows(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(),
                            "seconds_per_particle_step": t.seconds_per_particle_step,
                            "particle_steps_per_s": 1.0 / t.seconds_per_particle_step,
                            "timed_steps": t.timed_steps, "repetitions": t.repetitions}),
-                );
+                )?;
             }
         }
     }
@@ -215,7 +215,7 @@ fn pipeline_row(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(),
                "particle_steps_per_s": (particles * steps) as f64 / wall.max(1e-12),
                "seconds_per_step": wall / steps.max(1) as f64,
                "levitation_time_s": levitation_time}),
-    );
+    )?;
     Ok(())
 }
 
@@ -284,7 +284,7 @@ fn collision_bed_row(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Resul
                    "wall_time_s": wall,
                    "particle_steps_per_s": (n * steps) as f64 / wall.max(1e-12),
                    "collisions_so_far": s["collisions"]}),
-        );
+        )?;
     }
     Ok(())
 }

@@ -215,6 +215,5 @@ pub fn chart_collisions(out: &Path, quick: bool) -> Result<(), BenchError> {
         "thesis_delays_at_0.02": {"sinking": THESIS_DELAYS.0, "rising": THESIS_DELAYS.1},
         "runs": rows,
     });
-    println!("{summary}");
-    Ok(())
+    crate::studies::bench::say(summary)
 }

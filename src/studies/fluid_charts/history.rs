@@ -147,8 +147,7 @@ pub fn chart_history(out: &Path, quick: bool) -> Result<(), BenchError> {
         "stability": stability,
         "wall_time_s": r4(started.elapsed().as_secs_f64()),
     });
-    println!("{summary}");
-    Ok(())
+    crate::studies::bench::say(summary)
 }
 
 /// (a) error against cost for the window settings and time steps.

@@ -205,8 +205,7 @@ pub fn chart_levitation(out: &Path, quick: bool) -> Result<(), BenchError> {
         "sink_rise": sink_rise,
         "force_budget": budget,
     });
-    println!("{summary}");
-    Ok(())
+    crate::studies::bench::say(summary)
 }
 
 /// (a) y(t) without and with history.

@@ -229,9 +229,7 @@ pub fn chart_separation(out: &Path, quick: bool) -> Result<(), BenchError> {
             })
         })
         .collect();
-    println!(
-        "{}",
-        json!({"charts": [path.display().to_string(), path_g.display().to_string()], "quick": quick, "cases": cases})
-    );
-    Ok(())
+    crate::studies::bench::say(
+        json!({"charts": [path.display().to_string(), path_g.display().to_string()], "quick": quick, "cases": cases}),
+    )
 }

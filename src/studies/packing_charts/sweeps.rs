@@ -162,11 +162,9 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
     .panel(extrap);
     let path = out.join("cylinder_confinement.svg");
     save(&path, &fig.to_svg(560.0, 420.0))?;
-    println!(
-        "{}",
-        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary})
-    );
-    Ok(())
+    crate::studies::bench::say(
+        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "sweeps": summary}),
+    )
 }
 
 /// Wedge confinement (thesis figs. 2.12-2.16; target V-PK-17): phi*, \<C\>* against l_w / l_w,min and
@@ -280,11 +278,9 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     save(&path, &fig.to_svg(520.0, 420.0))?;
     let (hpath, histogram) =
         orientation_map(out, n, angles[0] * deg, *ratios.last().unwrap_or(&3.0))?;
-    println!(
-        "{}",
-        json!({"charts": [path.display().to_string(), hpath.display().to_string()], "particles": n, "runs": runs, "sweeps": summary, "orientation_density": histogram})
-    );
-    Ok(())
+    crate::studies::bench::say(
+        json!({"charts": [path.display().to_string(), hpath.display().to_string()], "particles": n, "runs": runs, "sweeps": summary, "orientation_density": histogram}),
+    )
 }
 
 /// Fig. 2.15: the orientation density of aspect-3 rods in the wedge of angle `alpha` [rad]
@@ -429,9 +425,7 @@ pub fn chart_superballs(out: &Path, quick: bool) -> Result<(), BenchError> {
     );
     let path = out.join("superballs.svg");
     save(&path, &fig.to_svg(520.0, 420.0))?;
-    println!(
-        "{}",
-        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "isotropic_s4_floor": floor, "fire": fire.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>(), "revised": revised.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>()})
-    );
-    Ok(())
+    crate::studies::bench::say(
+        json!({"charts": [path.display().to_string()], "particles": n, "runs": runs, "isotropic_s4_floor": floor, "fire": fire.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>(), "revised": revised.iter().map(|(g, p)| json!({"exponent": g, "point": p})).collect::<Vec<_>>()}),
+    )
 }
