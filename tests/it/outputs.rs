@@ -155,7 +155,7 @@ fn existing_outputs_need_force_and_bad_paths_exit_2() {
     let cases = [
         (sub.clone(), "is a directory"),
         (d.join("missing/x.mcap"), "does not exist"),
-        (scene.join("x.mcap"), "is not a directory"),
+        (scene.join("x.mcap"), "Not a directory"),
         (
             PathBuf::from("/proc/magsep-test.mcap"),
             "cannot create files in /proc",
