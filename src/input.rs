@@ -116,6 +116,7 @@ pub fn named_inputs(scene_text: &str) -> Vec<PathBuf> {
 mod tests {
     use super::*;
 
+    #[cfg(unix)]
     #[test]
     fn inputs_must_be_regular_files_of_bounded_size() {
         let dir = std::env::temp_dir().join(format!("magsep-input-{}", std::process::id()));

@@ -4,20 +4,15 @@
 //! one may exceed [`LARGEST_ALLOWED`] (the file is about 40 KB; the reader's ratio
 //! bound allows at most `max(1 MiB, 64 x compressed chunk)` for one chunk).
 //!
-//! Cases: 256 per property (three properties, 768 damaged files), about two seconds in
-//! release mode. The proptest seed is random per run; a failure prints the minimal case.
+//! Cases: 256 per property (four properties, 1024 damaged files), about a second in release
+//! mode. The proptest seed is random per run; a failure prints the minimal case.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::io::Cursor;
 use std::path::Path;
-use std::sync::OnceLock;
 
-use glam::{DQuat, DVec3};
-use magsep_record::{
-    ParticleFrame, ReadMode, ReaderLimits, RecordingMetadata, RecordingReader, RecordingWriter,
-    read_recording_bytes,
-};
+use magsep_record::{ReadMode, ReaderLimits, RecordingReader, read_recording_bytes};
 use proptest::prelude::*;
 use proptest::sample::Index;
 
@@ -59,56 +54,16 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
-/// The largest single allocation any case may cause: 8 MiB (the file is ~40 KB).
+/// The largest single allocation any case may cause: 8 MiB (the file is 28 KB).
 const LARGEST_ALLOWED: usize = 8 << 20;
 
 /// Cases per property.
 const CASES: u32 = 256;
 
-/// A real recording: 6 frames of 60 particles, summary and footer (~40 KB).
+/// A real recording: `magsep run tests/data/brownian_short.toml --record ...` (5 frames of 4
+/// particles, summary and footer, 28 KB), the base of the bad-recordings corpus.
 fn base() -> &'static [u8] {
-    static BYTES: OnceLock<Vec<u8>> = OnceLock::new();
-    BYTES.get_or_init(|| {
-        let path = std::env::temp_dir().join(format!("magsep-fuzz-{}.mcap", std::process::id()));
-        let meta = RecordingMetadata {
-            scene_text: "[simulation]\npipeline = \"test\"\n".into(),
-            seed: 7,
-            version: "test".into(),
-            pipeline: "test".into(),
-            dt: 1e-3,
-            ..Default::default()
-        };
-        let mut w = RecordingWriter::create(&path, &meta).unwrap();
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
-        for step in 0..6u64 {
-            let n = 60;
-            let mut u = || (next() >> 11) as f64 / (1u64 << 53) as f64;
-            let frame = ParticleFrame {
-                step: step * 10,
-                time: step as f64 * 1e-2,
-                box_edges: DVec3::splat(1e-5),
-                ids: (0..n as u64).collect(),
-                positions: (0..n).map(|_| DVec3::new(u(), u(), u()) * 1e-5).collect(),
-                orientations: vec![DQuat::IDENTITY; n],
-                radii: vec![1e-7; n],
-                half_lengths: vec![0.0; n],
-                rng_states: (0..n).map(|_| [next(), next(), next(), next()]).collect(),
-                status_json: format!("{{\"step\": {step}}}"),
-            };
-            w.write_frame(&frame, None).unwrap();
-        }
-        w.write_summary("{\"steps\": 50}").unwrap();
-        w.finish().unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        let _ = std::fs::remove_file(&path);
-        bytes
-    })
+    include_bytes!("../../tests/data/bad_recordings/base.mcap")
 }
 
 /// Starts of the top-level records (opcode bytes) of `bytes`, following lengths from the
@@ -238,10 +193,39 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: CASES, ..ProptestConfig::default() })]
+
+    /// A chunk's declared uncompressed or compressed size set to 2^e (+ jitter), e in 0..34:
+    /// sizes within the absolute limit but far beyond the chunk (the 1 KB chunks of the base
+    /// would allocate up to 64 MiB under the old 65536:1 bound) come up in about one case in
+    /// eight.
+    #[test]
+    fn reader_survives_rewritten_chunk_sizes(
+        chunk in any::<Index>(),
+        compressed in any::<bool>(),
+        e in 0u32..34,
+        jitter in any::<u16>(),
+    ) {
+        let mut bytes = base().to_vec();
+        let chunks: Vec<usize> = record_starts(&bytes)
+            .into_iter()
+            .filter(|&s| bytes[s] == 0x06)
+            .collect();
+        let c = chunks[chunk.index(chunks.len())] + 9;
+        let slen = u32::from_le_bytes(bytes[c + 28..c + 32].try_into().unwrap()) as usize;
+        let at = if compressed { c + 32 + slen } else { c + 16 };
+        let value = (1u64 << e).wrapping_add(u64::from(jitter));
+        bytes[at..at + 8].copy_from_slice(&value.to_le_bytes());
+        read_all(&bytes);
+    }
+}
+
 #[test]
 fn base_recording_reads_back_whole() {
     let rec = read_recording_bytes(base()).unwrap();
-    assert_eq!(rec.frames.len(), 6);
+    assert_eq!(rec.frames.len(), 5);
+    assert_eq!(rec.metadata.unwrap().pipeline, "brownian");
     assert!(rec.truncated.is_none() && rec.damaged.is_none());
     // every chunk is a candidate for the length rewrites
     let starts = record_starts(base());

@@ -3,6 +3,8 @@
 //! `--record` paths as bad input (exit 2), a closed or full standard output as an error
 //! rather than a panic, `--threads` capped; inputs that are not regular files refused.
 
+#![cfg(unix)]
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};

@@ -201,6 +201,7 @@ fn record_bytes_after_the_closing_magic_are_damage() {
     );
 }
 
+#[cfg(unix)]
 #[test]
 fn record_inputs_must_be_regular_files_and_are_never_quoted() {
     for path in ["/dev/zero", "/tmp"] {
@@ -222,4 +223,30 @@ fn record_inputs_must_be_regular_files_and_are_never_quoted() {
     // strings of a damaged file are quoted cut short
     assert_eq!(crate::parse::clip(&"x".repeat(1000)).len(), 64 + 3);
     assert_eq!(crate::parse::clip("short"), "short");
+}
+
+#[test]
+fn record_writer_refuses_frames_the_reader_would_refuse() {
+    let frames = random_frames(5, 3, true);
+    let path = TempFile::new("big-frame.mcap");
+    let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
+    w.write_frame(&frames[0], None).unwrap();
+    // a chunk limit of 200 bytes stands for the 1 GiB of MAX_CHUNK_BYTES
+    w.max_chunk = 200;
+    let big = ParticleFrame {
+        ids: (0..10).collect(),
+        positions: vec![glam::DVec3::ZERO; 10],
+        orientations: vec![glam::DQuat::IDENTITY; 10],
+        radii: vec![1.0; 10],
+        half_lengths: vec![0.0; 10],
+        rng_states: vec![[1, 2, 3, 4]; 10],
+        ..frames[1].clone()
+    };
+    let err = w.write_frame(&big, None).unwrap_err().to_string();
+    assert!(err.contains("more than the 200 bytes per chunk"), "{err}");
+    w.finish().unwrap();
+    // nothing of the refused frame was written: the file is intact
+    let rec = read_recording(path.as_ref()).unwrap();
+    assert_frames_bitwise_eq(&rec.frames, &frames[..1]);
+    assert_eq!((rec.truncated, rec.damaged), (None, None));
 }

@@ -76,6 +76,8 @@ pub struct RecordingWriter {
     decor: SceneDecor,
     /// Channels added by plugins, in the order added.
     channels: Vec<AddedChannel>,
+    /// Largest chunk a frame may take ([`MAX_CHUNK_BYTES`]; smaller in tests).
+    pub(crate) max_chunk: u64,
 }
 
 impl RecordingWriter {
@@ -104,6 +106,7 @@ impl RecordingWriter {
             buf: Vec::new(),
             decor: SceneDecor::default(),
             channels: Vec::new(),
+            max_chunk: MAX_CHUNK_BYTES,
         };
         let mut mcap = options
             .create(BufWriter::new(file))
@@ -185,12 +188,12 @@ impl RecordingWriter {
         encode_state(frame, &mut self.buf);
         // The frame's chunk holds both messages (record and message headers: 31 bytes each).
         let chunk = (self.buf.len() + scene.len() + 62) as u64;
-        if chunk > MAX_CHUNK_BYTES {
+        if chunk > self.max_chunk {
             return Err(RecordError::InvalidInput {
                 detail: format!(
                     "frame at step {} of {n} particles takes {chunk} bytes, more than the \
-                     {MAX_CHUNK_BYTES} bytes per chunk that readers accept",
-                    frame.step
+                     {} bytes per chunk that readers accept",
+                    frame.step, self.max_chunk
                 ),
             });
         }

@@ -5,6 +5,8 @@
 //! regenerated from `base.mcap` by `generate::corpus`; set `MAGSEP_WRITE_BAD_RECORDINGS=1` to
 //! write them (see the manifest's header).
 
+#![cfg(unix)]
+
 mod generate;
 
 use std::path::{Path, PathBuf};
