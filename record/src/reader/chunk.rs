@@ -17,7 +17,7 @@ use std::ops::Range;
 /// and to [`ReaderLimits::max_compression_ratio`] (64) times its compressed size (chunks that
 /// decompress to at most [`RATIO_FREE_BYTES`], 1 MiB, are exempt from the ratio). Real
 /// recordings stay far inside both: the chunks of the shipped scenes' recordings compress by
-/// 1.7-4.4 (the large ones, 0.1-16 MB, by 2.0-2.8), and a frame takes 240 (spheres) to 550
+/// 1.7-4.4 (the large ones, 0.1-17 MB, by 1.7-2.8), and a frame takes 240 (spheres) to 550
 /// (spherocylinders) bytes per particle before compression, so a 1 GiB chunk is a frame of
 /// 2-4 million particles; [`RecordingWriter`](crate::RecordingWriter) refuses to write a
 /// frame the default reader would refuse. A 33 KB zstd bomb declaring 1 GiB is refused
