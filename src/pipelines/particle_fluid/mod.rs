@@ -6,6 +6,7 @@ pub mod replay;
 pub mod scene;
 pub mod spawn;
 pub mod summary;
+mod validate;
 pub mod view;
 
 use bevy_ecs::prelude::*;

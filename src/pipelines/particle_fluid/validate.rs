@@ -1,0 +1,351 @@
+//! The checks of a particle-fluid scene: every value in its documented range (SI units),
+//! explicit start points inside the container and apart, `count` resolved from
+//! `volume_fraction`.
+
+use glam::DVec3;
+use magsep_systems::fluid::config::HistoryChoice;
+use magsep_systems::fluid::flow::FlowModel;
+
+use super::scene::{FluidContainerSpec, ParticleFluidScene, count_from_volume_fraction};
+use crate::scene::checks::{LENGTH_RANGE, check, finite_positive, within};
+use crate::scene::{ParticleGroup, PlacementSpec, SceneError, ShapeSpec};
+
+/// Densities accepted, of liquids and particles \[kg/m³\] (osmium is 22.6e3).
+pub const DENSITY_RANGE: (f64, f64) = (1.0, 3e4);
+/// Viscosities accepted \[Pa s\].
+pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
+/// Largest container edge, magnet size or position \[m\].
+pub const MAX_EXTENT: f64 = 100.0;
+/// Largest magnet surface field \[A/m\] (the strongest permanent magnets give about 1e6).
+pub const MAX_FIELD: f64 = 1e8;
+/// Largest flow or particle speed \[m/s\] (the model is Stokes-Oseen drag in a liquid).
+pub const MAX_SPEED: f64 = 100.0;
+/// Largest shear rate or flow frequency \[1/s\].
+pub const MAX_RATE: f64 = 1e6;
+
+/// The flow's values: finite, speeds at most [`MAX_SPEED`], rates at most [`MAX_RATE`].
+fn flow_checks(flow: &FlowModel, errors: &mut Vec<SceneError>) {
+    let speed = |errors: &mut Vec<SceneError>, key: &str, v: &[f64; 3]| {
+        for (k, c) in v.iter().enumerate() {
+            let path = format!("liquid.flow.{key}[{k}]");
+            within(errors, &path, *c, -MAX_SPEED, MAX_SPEED, "[m/s]");
+        }
+    };
+    match flow {
+        FlowModel::Quiescent => {}
+        FlowModel::Uniform { velocity } => speed(errors, "velocity", velocity),
+        FlowModel::Shear { rate } => within(
+            errors,
+            "liquid.flow.rate",
+            *rate,
+            -MAX_RATE,
+            MAX_RATE,
+            "[1/s]",
+        ),
+        FlowModel::Oscillating {
+            amplitude,
+            frequency,
+        } => {
+            speed(errors, "amplitude", amplitude);
+            within(
+                errors,
+                "liquid.flow.frequency",
+                *frequency,
+                1e-9,
+                MAX_RATE,
+                "[Hz]",
+            );
+        }
+    }
+}
+
+/// Check the particle-fluid sections; resolve `count` from `volume_fraction`.
+pub fn validate(
+    pf: &ParticleFluidScene,
+    groups: &mut [(usize, ParticleGroup)],
+    errors: &mut Vec<SceneError>,
+) {
+    let s = &pf.section;
+    check(
+        errors,
+        s.time_step.is_finite() && s.time_step > 0.0 && s.time_step <= 1.0,
+        "particle_fluid.time_step",
+        || format!("must be in (0, 1] s, got {}", s.time_step),
+    );
+    let steps = s.duration / s.time_step;
+    check(
+        errors,
+        s.duration.is_finite() && (0.5..=1e9).contains(&steps),
+        "particle_fluid.duration",
+        || format!("must give 1 to 1e9 steps of time_step, got {}", s.duration),
+    );
+    if let Some(g) = s.gravity {
+        check(
+            errors,
+            g.is_finite() && (0.0..=1000.0).contains(&g),
+            "particle_fluid.gravity",
+            || format!("must be in [0, 1000] m/s², got {g}"),
+        );
+    }
+    if let Some(t) = s.levitation_tolerance {
+        finite_positive(errors, "particle_fluid.levitation_tolerance", t);
+    }
+    check(
+        errors,
+        s.observe_every != Some(0),
+        "particle_fluid.observe_every",
+        || "must be >= 1, got 0".into(),
+    );
+    if let HistoryChoice::Window { window, .. } = s.history {
+        check(
+            errors,
+            window.is_finite() && window >= s.time_step && window / s.time_step <= 1.6e7,
+            "particle_fluid.history.window",
+            || format!("must be >= time_step and at most 1.6e7 steps [s], got {window}"),
+        );
+    }
+    let (lo, hi) = DENSITY_RANGE;
+    within(
+        errors,
+        "liquid.density",
+        pf.liquid.density,
+        lo,
+        hi,
+        "[kg/m³]",
+    );
+    let (lo, hi) = VISCOSITY_RANGE;
+    within(
+        errors,
+        "liquid.viscosity",
+        pf.liquid.viscosity,
+        lo,
+        hi,
+        "[Pa s]",
+    );
+    flow_checks(&pf.liquid.flow, errors);
+    let chi = pf.liquid.susceptibility;
+    check(
+        errors,
+        chi.is_finite() && (-1.0..=10.0).contains(&chi),
+        "liquid.susceptibility",
+        || format!("must be in [-1, 10], got {chi}"),
+    );
+    if let Some(m) = &pf.magnet {
+        within(
+            errors,
+            "magnet.surface_field",
+            m.surface_field,
+            0.0,
+            MAX_FIELD,
+            "[A/m]",
+        );
+        within(
+            errors,
+            "magnet.pole_size",
+            m.pole_size,
+            LENGTH_RANGE.0,
+            MAX_EXTENT,
+            "[m]",
+        );
+        within(
+            errors,
+            "magnet.half_height",
+            m.half_height,
+            LENGTH_RANGE.0,
+            MAX_EXTENT,
+            "[m]",
+        );
+        if let Some(z) = m.mid_plane {
+            within(
+                errors,
+                "magnet.mid_plane",
+                z,
+                -MAX_EXTENT,
+                MAX_EXTENT,
+                "[m]",
+            );
+        }
+    }
+    if let Err(e) = pf.collisions.model(&pf.liquid).validate() {
+        errors.push(SceneError::new("collisions", e.to_string()));
+    }
+    let edges = pf.container.edges();
+    let bounded = !matches!(pf.container, FluidContainerSpec::Unbounded {});
+    if bounded {
+        let keys = match pf.container {
+            FluidContainerSpec::Channel { .. } => ["side[0]", "side[1]", "height"],
+            _ => ["edges[0]", "edges[1]", "edges[2]"],
+        };
+        for (k, key) in keys.iter().enumerate() {
+            let path = format!("container.{key}");
+            within(errors, &path, edges[k], LENGTH_RANGE.0, MAX_EXTENT, "[m]");
+        }
+    }
+    let d_max = groups
+        .iter()
+        .map(|(_, g)| 2.0 * g.shape.shape().radius())
+        .fold(0.0, f64::max);
+    if bounded && edges.min_element() > 0.0 {
+        check(errors, edges.min_element() > d_max, "container", || {
+            format!("every extent must exceed the largest particle diameter {d_max} m")
+        });
+        if let FluidContainerSpec::Channel { side, .. } = pf.container {
+            check(
+                errors,
+                side[0].min(side[1]) > 4.0 * d_max,
+                "container.side",
+                || {
+                    format!(
+                        "periods must exceed 4 particle diameters ({} m)",
+                        4.0 * d_max
+                    )
+                },
+            );
+        }
+    }
+    for (i, g) in groups.iter_mut() {
+        validate_group(*i, g, pf, bounded, edges, errors);
+    }
+}
+
+fn validate_group(
+    i: usize,
+    g: &mut ParticleGroup,
+    pf: &ParticleFluidScene,
+    bounded: bool,
+    edges: DVec3,
+    errors: &mut Vec<SceneError>,
+) {
+    let p = format!("particles[{i}]");
+    let ShapeSpec::Sphere { radius } = g.shape else {
+        errors.push(SceneError::new(
+            format!("{p}.shape.kind"),
+            "the particle_fluid pipeline simulates spheres (spheroids come later)",
+        ));
+        return;
+    };
+    match (g.density, &g.density_ratios) {
+        (Some(rho), None) => {
+            let (lo, hi) = DENSITY_RANGE;
+            within(errors, &format!("{p}.density"), rho, lo, hi, "[kg/m³]")
+        }
+        (None, Some(r)) => {
+            let q = format!("{p}.density_ratios");
+            within(errors, &format!("{q}.min"), r.min, 1e-3, 1e3, "");
+            within(errors, &format!("{q}.max"), r.max, 1e-3, 1e3, "");
+            check(
+                errors,
+                r.max.is_finite() && r.max >= r.min,
+                &format!("{q}.max"),
+                || format!("must be >= min ({}), got {}", r.min, r.max),
+            );
+            check(errors, r.groups >= 1, &format!("{q}.groups"), || {
+                "must be >= 1, got 0".into()
+            });
+        }
+        _ => errors.push(SceneError::new(
+            format!("{p}.density"),
+            "give exactly one of density [kg/m³] or density_ratios",
+        )),
+    }
+    if let Some(v) = g.velocity {
+        check(
+            errors,
+            v.iter().all(|c| c.is_finite() && c.abs() <= MAX_SPEED),
+            &format!("{p}.velocity"),
+            || format!("must be three numbers in [-{MAX_SPEED}, {MAX_SPEED}] [m/s], got {v:?}"),
+        );
+    }
+    match g.volume_fraction {
+        Some(phi) => {
+            check(
+                errors,
+                phi.is_finite() && phi > 0.0 && phi <= 0.5,
+                &format!("{p}.volume_fraction"),
+                || format!("must be in (0, 0.5], got {phi}"),
+            );
+            check(errors, bounded, &format!("{p}.volume_fraction"), || {
+                "needs a bounded [container] (channel or tank)".into()
+            });
+            check(errors, g.count == 0, &format!("{p}.count"), || {
+                "give count or volume_fraction, not both".into()
+            });
+            if bounded && phi > 0.0 && radius > 0.0 {
+                g.count = count_from_volume_fraction(phi, pf.container.volume(), radius);
+                check(
+                    errors,
+                    g.count >= 1,
+                    &format!("{p}.volume_fraction"),
+                    || "gives no particle".into(),
+                );
+            }
+        }
+        None => check(errors, g.count >= 1, &format!("{p}.count"), || {
+            format!("must be >= 1 (or give volume_fraction), got {}", g.count)
+        }),
+    }
+    let q = format!("{p}.placement");
+    match &g.placement {
+        None => errors.push(SceneError::new(q, "missing required key (a start region)")),
+        Some(PlacementSpec::Box { min, max }) => {
+            if !(0..3).all(|k| min[k].is_finite() && max[k].is_finite() && max[k] > min[k]) {
+                errors.push(SceneError::new(
+                    format!("{q}.max"),
+                    format!("must exceed min on every axis, got min {min:?}, max {max:?}"),
+                ));
+            }
+        }
+        Some(PlacementSpec::Points { positions }) => {
+            if positions.len() as u64 != g.count {
+                errors.push(SceneError::new(
+                    format!("{q}.positions"),
+                    format!(
+                        "must hold count = {} points, got {}",
+                        g.count,
+                        positions.len()
+                    ),
+                ));
+            }
+            for (k, x) in positions.iter().enumerate() {
+                let inside = (0..3).all(|a| {
+                    x[a].is_finite() && (!bounded || (x[a] >= radius && x[a] <= edges[a] - radius))
+                });
+                check(errors, inside, &format!("{q}.positions[{k}]"), || {
+                    format!("must be finite and inside the container, got {x:?}")
+                });
+            }
+            if let Some((a, b)) = crate::scene::placement::first_overlap(positions, radius) {
+                errors.push(SceneError::new(
+                    format!("{q}.positions[{b}]"),
+                    format!("overlaps positions[{a}]: centres closer than a diameter"),
+                ));
+            }
+        }
+        Some(PlacementSpec::Injection {
+            heavy,
+            light,
+            impurity,
+        }) => {
+            check(errors, bounded, &q, || "needs a bounded [container]".into());
+            for (name, z) in [("heavy", heavy), ("light", light)] {
+                let ok = z[0].is_finite() && z[1].is_finite() && z[1] > z[0];
+                let inside = !bounded || (z[0] >= 0.0 && z[1] <= edges.z);
+                check(errors, ok && inside, &format!("{q}.{name}"), || {
+                    format!(
+                        "must be [z_min, z_max] inside the container with z_max > z_min, got {z:?}"
+                    )
+                });
+            }
+            check(
+                errors,
+                impurity.is_finite() && (0.0..=1.0).contains(impurity),
+                &format!("{q}.impurity"),
+                || format!("must be in [0, 1], got {impurity}"),
+            );
+        }
+        Some(_) => errors.push(SceneError::new(
+            format!("{q}.kind"),
+            "the particle_fluid pipeline places particles by box, points or injection",
+        )),
+    }
+}
