@@ -8,6 +8,7 @@ use crate::plugins::record::{
     trailing_message,
 };
 use crate::replay::{ReplayError, replay_with};
+use crate::scene::{Registry, parse_scene};
 use serde_json::json;
 
 use super::output::{Input, check_file, eprint, print};
@@ -89,8 +90,14 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
 /// `magsep info`: prints what can be read; exit 0 for a complete or a truncated file (a run
 /// that was killed), 2 for a damaged one (a corrupt record, bytes after the footer) after
 /// printing what could be read.
-pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
+pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliError> {
     let rec = scan(path)?;
+    // the memory the recorded scene needs to run again (when this program can parse it)
+    let memory = rec
+        .metadata
+        .as_ref()
+        .and_then(|m| parse_scene(&m.scene_text, registry).ok())
+        .map(|scene| crate::scene::memory::estimate(&scene));
     let damaged = || match &rec.damaged {
         Some(d) => Err(CliError::input(format!(
             "{} is damaged: {d}",
@@ -117,6 +124,7 @@ pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
             "damaged": rec.damaged,
             "trailing_bytes": rec.trailing_bytes,
             "complete": rec.truncated.is_none() && rec.damaged.is_none(),
+            "memory_estimate_bytes": memory.as_ref().map(|m| m.bytes.round() as u64),
             "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
             "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
         });
@@ -163,6 +171,13 @@ pub fn info(path: &Path, as_json: bool) -> Result<(), CliError> {
                 "scene text ({} lines)",
                 m.scene_text.lines().count()
             ));
+            if let Some(e) = &memory {
+                line(format!(
+                    "memory     about {} to run the scene ({})",
+                    crate::scene::memory::gib(e.bytes),
+                    e.detail
+                ));
+            }
         }
         None => line("metadata   none".into()),
     }

@@ -283,7 +283,7 @@ pub fn main_with(ext: Extensions) -> i32 {
             },
             threads,
         ),
-        Command::Info { recording, json } => info::info(&recording, json),
+        Command::Info { recording, json } => info::info(&recording, json, &ext.registry),
         Command::Replay {
             recording,
             resume,

@@ -86,19 +86,24 @@ pub fn budget(override_gib: Option<f64>) -> Result<u64, String> {
     }
 }
 
-/// The scene's estimate, or an error at its key when it exceeds `budget` \[bytes\].
-///
-/// # Errors
-/// A [`SceneError`] at the estimate's key, with both sizes and how to raise the budget.
-pub fn check(scene: &Scene, budget: u64) -> Result<MemoryEstimate, SceneError> {
-    let estimate = match &scene.pipeline {
+/// The scene's estimate (its pipeline's, or [`BASE_BYTES`] for a field-only scene).
+pub fn estimate(scene: &Scene) -> MemoryEstimate {
+    match &scene.pipeline {
         Some(p) => p.memory_estimate(scene),
         None => MemoryEstimate {
             bytes: BASE_BYTES,
             key: "fibres".into(),
             detail: "a field-only scene".into(),
         },
-    };
+    }
+}
+
+/// The scene's estimate, or an error at its key when it exceeds `budget` \[bytes\].
+///
+/// # Errors
+/// A [`SceneError`] at the estimate's key, with both sizes and how to raise the budget.
+pub fn check(scene: &Scene, budget: u64) -> Result<MemoryEstimate, SceneError> {
+    let estimate = estimate(scene);
     if estimate.bytes > budget as f64 || !estimate.bytes.is_finite() {
         return Err(SceneError::new(
             estimate.key.clone(),
