@@ -174,6 +174,10 @@ pub enum SimError {
     /// The recording could not be written.
     #[error("recording failed: {0}")]
     Record(#[from] RecordError),
+    /// Writing the recording failed during the run (the message names the file and the OS
+    /// error); the run stopped at once.
+    #[error("recording failed: {0}")]
+    RecordWrite(String),
     /// The scene has no `[simulation]` (a field-only scene: use `magsep field`).
     #[error("the scene has no [simulation] to run (a field-only scene: use `magsep field`)")]
     NothingToRun,
@@ -183,6 +187,42 @@ pub enum SimError {
     /// A numerical failure was reported.
     #[error("numerical failure: {0}")]
     Health(String),
+    /// The run stopped on `error` (e.g. a recording write failure); `summary` is the summary
+    /// of what ran, with the error's message as `"run_error"` (and `"interrupted": true` when
+    /// the run ended before its end).
+    #[error("{error}")]
+    Partial {
+        /// Why the run stopped.
+        error: Box<SimError>,
+        /// The summary of the steps that ran.
+        summary: Box<serde_json::Value>,
+    },
+}
+
+impl SimError {
+    /// The summary of what ran before the error, when the run got that far.
+    pub fn partial_summary(&self) -> Option<&serde_json::Value> {
+        match self {
+            Self::Partial { summary, .. } => Some(summary),
+            _ => None,
+        }
+    }
+
+    /// The error itself, without its partial summary.
+    pub fn cause(&self) -> &SimError {
+        match self {
+            Self::Partial { error, .. } => error.cause(),
+            e => e,
+        }
+    }
+
+    /// The error without its partial summary.
+    pub fn into_cause(self) -> SimError {
+        match self {
+            Self::Partial { error, .. } => error.into_cause(),
+            e => e,
+        }
+    }
 }
 
 /// Why a replay or a resume failed.

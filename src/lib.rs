@@ -34,7 +34,9 @@ pub mod prelude {
     pub use crate::pipelines::packing::PackingPipeline;
     pub use crate::pipelines::particle_fluid::ParticleFluidPipeline;
     pub use crate::scene::{ParseContext, Pipeline, Registry, RunInfo, Scene, SceneSection};
-    pub use crate::sim::{RunOptions, SimError, Simulation, SimulationBuilder, SummaryExtras};
+    pub use crate::sim::{
+        RunOptions, SimError, Simulation, SimulationBuilder, StopFlag, SummaryExtras,
+    };
     pub use magsep_components::prelude::*;
     pub use magsep_plugins::app::{SimApp, SimPlugin};
     pub use magsep_plugins::brownian::{

@@ -11,13 +11,14 @@ use magsep_components::prelude::*;
 use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
 use magsep_plugins::record::{
-    FibreShape, PluginInfo, RecordError, RecordingMetadata, RecordingWriter,
+    FibreShape, PluginInfo, RecordingMetadata, RecordingWriter,
 };
-use magsep_plugins::recorder::{Recorder, record_now};
+use magsep_plugins::recorder::{Recorder, record_now, recording_error};
 use serde_json::Value;
 
 pub use crate::error::SimError;
 pub use crate::scene::RunOptions;
+pub use crate::scene::pipeline::StopFlag;
 use crate::scene::{NoProgress, Pipeline, Progress, RecordEvery, RunInfo, Scene, spawn_scene};
 
 /// A simulation built from a scene.
@@ -36,6 +37,8 @@ pub struct Simulation {
     pub pipeline: Arc<dyn Pipeline>,
     /// Seed of the run.
     pub seed: u64,
+    /// Polled between steps: once set, [`run`](Self::run) ends after the current step.
+    pub stop: Option<StopFlag>,
     started: Instant,
 }
 
@@ -79,6 +82,12 @@ impl SimulationBuilder<'_> {
     /// Override the scene's seed.
     pub fn seed(mut self, seed: u64) -> Self {
         self.options.seed = Some(seed);
+        self
+    }
+
+    /// Stop the run early when `stop` is set (see [`StopFlag`]).
+    pub fn stop_flag(mut self, stop: StopFlag) -> Self {
+        self.options.stop = Some(stop);
         self
     }
 
@@ -154,6 +163,7 @@ impl Simulation {
             app,
             pipeline: pipeline.clone(),
             seed,
+            stop: options.stop.clone(),
             started: Instant::now(),
         })
     }
@@ -171,12 +181,30 @@ impl Simulation {
     /// Step until the run ends; `on_step` sees the world after every step. Records the first
     /// and the final frame, finishes the recording and returns the summary.
     ///
+    /// When [`stop`](Self::stop) is set, the run ends after the current step: the final frame
+    /// is recorded, the recording closed (with the reason, see
+    /// `RecordingWriter::write_interrupted`), and the summary of what ran is returned, marked
+    /// `"interrupted": true` and `"interrupted_by": reason`.
+    ///
     /// # Errors
-    /// A recording write failure or a reported numerical failure.
+    /// A reported numerical failure; a recording write failure, at once (checked after every
+    /// step), as [`SimError::Partial`] with the summary of what ran (what was written stays
+    /// readable).
     pub fn run(&mut self, mut on_step: impl FnMut(&World)) -> Result<Value, SimError> {
         self.started = Instant::now();
         record_now(&mut self.app.world);
-        while !self.is_finished() {
+        let mut interrupted = None;
+        loop {
+            if let Some(e) = recording_error(&self.app.world) {
+                return Err(self.stopped_by(SimError::RecordWrite(e.to_string())));
+            }
+            if self.is_finished() {
+                break;
+            }
+            if let Some(reason) = self.stop.as_ref().and_then(StopFlag::reason) {
+                interrupted = Some(reason);
+                break;
+            }
             self.step();
             on_step(&self.app.world);
             let failed = self
@@ -191,9 +219,24 @@ impl Simulation {
             }
         }
         record_now(&mut self.app.world);
-        let summary = self.summary();
-        self.finish_recording(&summary)?;
+        let mut summary = self.summary();
+        if let Some(reason) = &interrupted {
+            mark_interrupted(&mut summary, reason);
+        }
+        if let Err(e) = self.finish_recording(&summary) {
+            return Err(partial(e, summary));
+        }
         Ok(summary)
+    }
+
+    /// The run stops early on `error`: close the recording best-effort and attach the
+    /// summary of what ran, marked interrupted.
+    fn stopped_by(&mut self, error: SimError) -> SimError {
+        // Dropping the writer closes the file best-effort; what was written stays readable.
+        drop(self.app.world.remove_resource::<Recorder>());
+        let mut summary = self.summary();
+        mark_interrupted(&mut summary, "error");
+        partial(error, summary)
     }
 
     /// The JSON summary of the current state (the pipeline's, plus the keys plugins added
@@ -216,21 +259,48 @@ impl Simulation {
         summary
     }
 
-    /// Write the summary into the recording and close it.
+    /// Write the summary into the recording and close it; a summary marked
+    /// `"interrupted_by"` (see [`mark_interrupted`]) also writes the recording's interrupted
+    /// record.
     ///
     /// # Errors
-    /// A recording write failure.
+    /// A recording write failure (also one that happened earlier in the run).
     pub fn finish_recording(&mut self, summary: &Value) -> Result<(), SimError> {
         if let Some(mut rec) = self.app.world.remove_resource::<Recorder>() {
             if let Some(e) = rec.error.take() {
-                return Err(SimError::Record(RecordError::InvalidInput { detail: e }));
+                return Err(SimError::RecordWrite(e));
             }
             if let Some(mut w) = rec.writer.take() {
+                if let Some(reason) = summary.get("interrupted_by").and_then(Value::as_str) {
+                    w.write_interrupted(reason)?;
+                }
                 w.write_summary(&summary.to_string())?;
                 w.finish()?;
             }
         }
         Ok(())
+    }
+}
+
+/// Mark `summary` (an object) as the summary of a run stopped early: `"interrupted": true`,
+/// `"interrupted_by": reason`.
+pub fn mark_interrupted(summary: &mut Value, reason: &str) {
+    if let Value::Object(map) = summary {
+        map.insert("interrupted".into(), Value::Bool(true));
+        map.insert("interrupted_by".into(), Value::String(reason.into()));
+    }
+}
+
+/// `error` with `summary` attached, the error's message added to it as `"run_error"` (an
+/// error that already carries a summary gives up that summary for this one).
+pub fn partial(error: SimError, mut summary: Value) -> SimError {
+    let error = error.into_cause();
+    if let Value::Object(map) = &mut summary {
+        map.insert("run_error".into(), Value::String(error.to_string()));
+    }
+    SimError::Partial {
+        error: Box::new(error),
+        summary: Box::new(summary),
     }
 }
 
@@ -309,10 +379,12 @@ fn open_recording(
 }
 
 /// Run `scene` to the end the pipeline's way (one simulation, or e.g. replicates), reporting
-/// to `progress`; returns the summary.
+/// to `progress`; returns the summary. A set [`RunOptions::stop`] ends the run early with the
+/// summary of what ran, marked interrupted (see [`StopFlag`]).
 ///
 /// # Errors
-/// [`SimError`] of the run.
+/// [`SimError`] of the run ([`SimError::Partial`] with the summary of what ran when a
+/// recording write failed mid-run).
 pub fn run_scene(
     scene: &Scene,
     options: &RunOptions,

@@ -5,6 +5,12 @@
 //! `status_json`), [`ParticleColours`] or [`ColourProvider`], and writes channels of its own
 //! through [`Recorder::writer`].
 //!
+//! A write error is never deferred: the first one is kept in [`Recorder::error`] (with the
+//! file and the OS error), the writer is dropped (which closes the file best-effort, so what
+//! was written stays readable), and the simulation driver checks [`recording_error`] after
+//! every step and stops the run at once. A plugin writing a channel of its own reports its
+//! errors the same way, through [`Recorder::fail`].
+//!
 //! | set | system | touches |
 //! |---|---|---|
 //! | `Record` | [`record_frame`] (exclusive) | `Recorder`; reads particles, `StepClock`, `Container`, the providers |
@@ -30,10 +36,28 @@ pub struct Recorder {
     pub writer: Option<RecordingWriter>,
     /// Record every this many steps (>= 1).
     pub every: u64,
-    /// First write error (recording stops after it).
+    /// First write error (recording stops after it, and the driver stops the run).
     pub error: Option<String>,
     /// Step of the last written frame.
     pub last_step: Option<u64>,
+}
+
+impl Recorder {
+    /// Report a write error: the first one is kept, the writer is dropped (closing the file
+    /// best-effort) and nothing more is recorded; the driver stops the run after this step.
+    pub fn fail(&mut self, error: impl Into<String>) {
+        if self.error.is_none() {
+            self.error = Some(error.into());
+        }
+        self.writer = None;
+    }
+}
+
+/// The recording's first write error, if one happened (the driver polls it every step).
+pub fn recording_error(world: &World) -> Option<&str> {
+    world
+        .get_resource::<Recorder>()
+        .and_then(|r| r.error.as_deref())
 }
 
 /// A function giving one key of a frame's status (`None`: leave the key out).
@@ -176,10 +200,7 @@ pub fn record_now(world: &mut World) {
         .as_mut()
         .map(|w| w.write_frame(&frame, colours.as_deref()));
     match result {
-        Some(Err(e)) => {
-            rec.error = Some(e.to_string());
-            rec.writer = None;
-        }
+        Some(Err(e)) => rec.fail(format!("frame at step {}: {e}", frame.step)),
         _ => rec.last_step = Some(frame.step),
     }
 }

@@ -100,7 +100,7 @@ pub use reader::{
     read_last_frame, read_recording, read_recording_bytes, trailing_message,
 };
 pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
-pub use writer::{ChannelHandle, RecordingWriter, log_time_ns};
+pub use writer::{ChannelHandle, RecordingSink, RecordingWriter, log_time_ns};
 
 /// Topic of the lossless particle state channel (schema `magsep.ParticleState`).
 pub const STATE_TOPIC: &str = "/state";
@@ -112,6 +112,9 @@ pub const STATE_SCHEMA_NAME: &str = "magsep.ParticleState";
 pub const METADATA_NAME: &str = "magsep";
 /// Name of the MCAP metadata record holding the run summary (key `summary`, JSON text).
 pub const SUMMARY_METADATA_NAME: &str = "magsep.summary";
+/// Name of the MCAP metadata record written when a run was stopped before its end (key
+/// `reason`, e.g. `SIGINT`); see [`RecordingWriter::write_interrupted`].
+pub const INTERRUPTED_METADATA_NAME: &str = "magsep.interrupted";
 /// Foxglove frame id of all scene entities.
 pub const SCENE_FRAME_ID: &str = "world";
 

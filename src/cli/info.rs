@@ -37,6 +37,8 @@ struct Scan {
     metadata: Option<RecordingMetadata>,
     summary_json: Option<String>,
     file_bytes: u64,
+    /// Why the run was stopped early (record `magsep.interrupted`), if it was.
+    interrupted: Option<String>,
 }
 
 /// Reads the recording at `path` linearly, checking every CRC; frames are decoded and
@@ -84,6 +86,11 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
         metadata: reader.metadata().cloned(),
         summary_json: reader.summary_json().map(str::to_string),
         file_bytes: reader.file_bytes(),
+        interrupted: reader
+            .metadata_records()
+            .iter()
+            .find(|m| m.name == crate::plugins::record::INTERRUPTED_METADATA_NAME)
+            .and_then(|m| m.entries.get("reason").cloned()),
     })
 }
 
@@ -124,6 +131,7 @@ pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliEr
             "damaged": rec.damaged,
             "trailing_bytes": rec.trailing_bytes,
             "complete": rec.truncated.is_none() && rec.damaged.is_none(),
+            "interrupted": rec.interrupted,
             "memory_estimate_bytes": memory.as_ref().map(|m| m.bytes.round() as u64),
             "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
             "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
@@ -145,6 +153,11 @@ pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliEr
         (Some(d), _) => line(format!("status     DAMAGED: {d}")),
         (None, Some(t)) => line(format!("status     TRUNCATED: {t}")),
         (None, None) => line("status     complete".into()),
+    }
+    if let Some(why) = &rec.interrupted {
+        line(format!(
+            "interrupted by {why}: the run was stopped before its end"
+        ));
     }
     line(format!(
         "frames     {} (steps {:?}..{:?})",

@@ -1,8 +1,9 @@
 //! The `magsep` command line (clap), also for a user's own binary: [`main_with`] gives it
 //! `run`, `validate`, `info`, `replay` (and the rest) with its own pipelines and plugins.
 //! Each command returns `Result<(), CliError>`; the error's code is the process exit code
-//! (0 ok, 2 bad input, 1 runtime failure). Output paths are checked before anything runs,
-//! and standard output is written without panicking (module `output`).
+//! (0 ok, 2 bad input, 1 runtime failure, 130/143 a run stopped by SIGINT/SIGTERM, see
+//! [`signals`]). Output paths are checked before anything runs, and standard output is
+//! written without panicking (module `output`).
 //!
 //! ```no_run
 //! use magsep::cli::{Extensions, main_with};
@@ -26,9 +27,10 @@ mod field;
 mod info;
 mod output;
 mod run;
+pub mod signals;
 
-/// A CLI failure with its exit code (2 bad input, 1 runtime failure). An empty message is
-/// not printed (a closed standard output ends the command quietly).
+/// A CLI failure with its exit code (2 bad input, 1 runtime failure, 130/143 interrupted). An
+/// empty message is not printed (a closed standard output ends the command quietly).
 #[derive(Debug)]
 pub struct CliError {
     /// Exit code.

@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::{Progress, RunOptions, Scene, parse_scene};
-use crate::sim::{SimError, run_scene};
+use crate::sim::{SimError, StopFlag, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::output::{Input, check_file, print};
-use super::{CliError, Extensions};
+use super::{CliError, Extensions, signals};
 
 /// Most worker threads `--threads` accepts: more than any machine has cores, and cheap to
 /// refuse (asking for 100000 threads once spent 10-16 s spawning them before failing).
@@ -134,11 +134,15 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
     let single = set_threads(threads)?;
     let scene = parse(ext, path, &text)?;
     memory(&scene, path, memory_budget)?;
+    let stop = StopFlag::new();
+    let signals = signals::install(&stop)
+        .map_err(|e| CliError::runtime(format!("cannot install the signal handlers: {e}")))?;
     let options = RunOptions {
         seed,
         record,
         single_threaded: single,
         plugins: ext.plugins.clone(),
+        stop: Some(stop),
         ..Default::default()
     };
     let bar = if quiet {
@@ -150,14 +154,35 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
-    let summary = run_scene(&scene, &options, &Bar(bar.clone())).map_err(|e| match e {
+    let result = run_scene(&scene, &options, &Bar(bar.clone()));
+    bar.finish_and_clear();
+    if let Some(partial) = result.as_ref().err().and_then(SimError::partial_summary) {
+        // the run's error matters more than a failing stdout
+        let _ = print(serde_json::to_string_pretty(partial).unwrap_or_default());
+    }
+    let summary = result.map_err(|e| match e.cause() {
         // a scene that validates but cannot be spawned (a start region too small for its
         // particles, a start box inside a fibre) is bad input too
         SimError::NothingToRun | SimError::Spawn(_) => CliError::input(e.to_string()),
-        e => CliError::runtime(e.to_string()),
+        _ => CliError::runtime(e.to_string()),
     })?;
-    bar.finish_and_clear();
     print(serde_json::to_string_pretty(&summary).unwrap_or_default())?;
+    if summary["interrupted"] == true
+        && let Some(code) = signals.exit_code()
+    {
+        return Err(CliError {
+            code,
+            message: format!(
+                "interrupted by {}: the summary above is of the steps that ran{}",
+                summary["interrupted_by"].as_str().unwrap_or("a signal"),
+                if options.record.is_some() {
+                    "; the recording is closed and complete"
+                } else {
+                    ""
+                }
+            ),
+        });
+    }
     if let Some(why) = scene.pipeline.as_ref().and_then(|p| p.failure(&summary)) {
         return Err(CliError::runtime(why));
     }

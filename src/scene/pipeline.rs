@@ -11,7 +11,7 @@
 use std::any::Any;
 use std::fmt;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use bevy_ecs::prelude::*;
 use magsep_plugins::app::SimPlugin;
@@ -137,6 +137,93 @@ pub struct RunOptions {
     pub resume_from: Option<ParticleFrame>,
     /// Plugins built after the pipeline's group (a user's forces, observers, channels).
     pub plugins: Vec<Arc<dyn SimPlugin>>,
+    /// Stop the run early when this flag is set (polled between steps; `magsep run` sets it on
+    /// SIGINT/SIGTERM).
+    pub stop: Option<StopFlag>,
+}
+
+/// A request to end a run early, shared between threads (its clones are one flag).
+///
+/// The driver ([`Simulation::run`](crate::sim::Simulation::run), `run_scene` and every
+/// pipeline's own [`Pipeline::run`]) polls it between steps. Once it is set, the current step
+/// ends, the final frame is recorded, the recording is closed with its footer and a metadata
+/// record `magsep.interrupted` (key `reason`), and the run returns the summary of what ran,
+/// marked `"interrupted": true` and `"interrupted_by": reason`. `magsep run` sets it on
+/// SIGINT and SIGTERM; a library user sets it from any thread (a timeout, a UI button).
+///
+/// ```
+/// use magsep::prelude::*;
+/// use magsep::sim::StopFlag;
+/// let scene = magsep::scene::parse_scene(
+///     r#"
+/// [simulation]
+/// pipeline = "packing"
+/// [container]
+/// kind = "periodic_box"
+/// [[particles]]
+/// count = 20
+/// shape = { kind = "sphere", radius = 0.5 }
+/// "#,
+///     &Default::default(),
+/// )
+/// .unwrap();
+/// let stop = StopFlag::new();
+/// let options = RunOptions { stop: Some(stop.clone()), ..Default::default() };
+/// let mut sim = Simulation::from_scene(&scene, options).unwrap();
+/// let summary = sim
+///     .run(|world| {
+///         if world.resource::<StepClock>().step == 3 {
+///             stop.request_stop("enough steps");
+///         }
+///     })
+///     .unwrap();
+/// assert_eq!(summary["interrupted"], true);
+/// assert_eq!(summary["interrupted_by"], "enough steps");
+/// let steps = &summary["compression_steps"].as_u64().unwrap() + summary["failed_steps"].as_u64().unwrap();
+/// assert_eq!(steps, 3);
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct StopFlag(Arc<StopState>);
+
+#[derive(Debug, Default)]
+struct StopState {
+    reason: OnceLock<String>,
+    parent: Option<StopFlag>,
+}
+
+impl StopFlag {
+    /// A flag not yet set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A flag that is set when `self` is, and can also be set on its own without setting
+    /// `self` (e.g. one replicate's failure stopping its siblings).
+    pub fn child(&self) -> Self {
+        Self(Arc::new(StopState {
+            reason: OnceLock::new(),
+            parent: Some(self.clone()),
+        }))
+    }
+
+    /// Ask the run to stop, saying why (e.g. `SIGINT`); the first reason given is kept.
+    pub fn request_stop(&self, reason: impl Into<String>) {
+        let _ = self.0.reason.set(reason.into());
+    }
+
+    /// Whether a stop was requested (of this flag or of its parent).
+    pub fn is_stopped(&self) -> bool {
+        self.0.reason.get().is_some() || self.0.parent.as_ref().is_some_and(Self::is_stopped)
+    }
+
+    /// Why the stop was requested, if it was.
+    pub fn reason(&self) -> Option<String> {
+        self.0
+            .reason
+            .get()
+            .cloned()
+            .or_else(|| self.0.parent.as_ref().and_then(Self::reason))
+    }
 }
 
 /// What a summary knows of the run beyond the world.
@@ -229,7 +316,10 @@ pub trait Pipeline: Send + Sync + 'static {
     fn prepare_recording(&self, _world: &mut World, _writer: &mut RecordingWriter) {}
 
     /// Run the scene in a way of the pipeline's own (e.g. replicates in parallel);
-    /// `None` lets the driver run one simulation.
+    /// `None` lets the driver run one simulation. It must honour [`RunOptions::stop`] as the
+    /// driver does: pass it to every simulation it runs (each polls it between steps), start
+    /// no more work once it is set, and return the summary of what ran, marked
+    /// `"interrupted": true` and `"interrupted_by"` (`crate::sim::mark_interrupted`).
     ///
     /// # Errors
     /// [`SimError`] of the run.

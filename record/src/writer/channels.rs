@@ -2,7 +2,10 @@
 
 use super::RecordingWriter;
 use crate::schema::ProtobufSchema;
-use crate::{METADATA_NAME, RecordError, SCENE_TOPIC, STATE_TOPIC, SUMMARY_METADATA_NAME};
+use crate::{
+    INTERRUPTED_METADATA_NAME, METADATA_NAME, RecordError, SCENE_TOPIC, STATE_TOPIC,
+    SUMMARY_METADATA_NAME,
+};
 use mcap::records::MessageHeader;
 use std::collections::BTreeMap;
 
@@ -139,14 +142,19 @@ impl RecordingWriter {
     /// plugins add; readers list every record in file order (`metadata_records`).
     ///
     /// Fails with [`RecordError::InvalidInput`] for an empty name or the reserved names
-    /// [`METADATA_NAME`] and [`SUMMARY_METADATA_NAME`] (use
-    /// [`write_summary`](Self::write_summary) for the latter).
+    /// [`METADATA_NAME`], [`SUMMARY_METADATA_NAME`] and [`INTERRUPTED_METADATA_NAME`] (use
+    /// [`write_summary`](Self::write_summary) and
+    /// [`write_interrupted`](Self::write_interrupted) for the latter two).
     pub fn add_metadata(
         &mut self,
         name: &str,
         entries: BTreeMap<String, String>,
     ) -> Result<(), RecordError> {
-        if name.is_empty() || name == METADATA_NAME || name == SUMMARY_METADATA_NAME {
+        if name.is_empty()
+            || name == METADATA_NAME
+            || name == SUMMARY_METADATA_NAME
+            || name == INTERRUPTED_METADATA_NAME
+        {
             return Err(RecordError::InvalidInput {
                 detail: format!("metadata name {name:?} is empty or reserved"),
             });

@@ -11,8 +11,8 @@ use crate::proto::{encode_state, particle_count, state_schema};
 use crate::reader::MAX_CHUNK_BYTES;
 use crate::scene::{SceneDecor, scene_update};
 use crate::{
-    METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata, SCENE_TOPIC, STATE_TOPIC,
-    SUMMARY_METADATA_NAME,
+    INTERRUPTED_METADATA_NAME, METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata,
+    SCENE_TOPIC, STATE_TOPIC, SUMMARY_METADATA_NAME,
 };
 use channels::AddedChannel;
 use foxglove::Encode;
@@ -21,13 +21,32 @@ use glam::DVec3;
 use mcap::records::{MessageHeader, Metadata};
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
-type McapWriter = mcap::Writer<BufWriter<File>>;
+/// Where a recording's bytes go: a [`File`], or any seekable sink (an in-memory buffer, or in
+/// tests one that fails like a full disk), see [`RecordingWriter::from_sink`].
+pub trait RecordingSink: Write + Seek + Send + Sync {
+    /// Make what was written durable (a file: `sync_all`); called by
+    /// [`RecordingWriter::finish`]. The default does nothing.
+    fn sync(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl RecordingSink for File {
+    fn sync(&mut self) -> std::io::Result<()> {
+        self.sync_all()
+    }
+}
+
+impl RecordingSink for std::io::Cursor<Vec<u8>> {}
+
+type McapWriter = mcap::Writer<BufWriter<Box<dyn RecordingSink>>>;
 
 // The writer lives in a bevy_ecs `Resource`, which must be `Send + Sync`. With mcap's
-// zstd-only build `mcap::Writer<BufWriter<File>>` is both; fail the build if that changes.
+// zstd-only build `mcap::Writer<BufWriter<Box<dyn RecordingSink>>>` is both (the sink trait
+// requires it); fail the build if that changes.
 const _: fn() = || {
     fn assert_send_sync<T: Send + Sync>() {}
     assert_send_sync::<McapWriter>();
@@ -91,6 +110,17 @@ impl RecordingWriter {
             path: path.to_path_buf(),
             source,
         })?;
+        Self::from_sink(path, Box::new(file), meta)
+    }
+
+    /// As [`create`](Self::create), writing to `sink` instead of a file created at `path`
+    /// (`path` names the output in errors). Every write error of the sink is returned by the
+    /// call that hit it, naming `path` and the OS error.
+    pub fn from_sink(
+        path: &Path,
+        sink: Box<dyn RecordingSink>,
+        meta: &RecordingMetadata,
+    ) -> Result<Self, RecordError> {
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .library(format!("magsep-record/{}", env!("CARGO_PKG_VERSION")))
@@ -109,7 +139,7 @@ impl RecordingWriter {
             max_chunk: MAX_CHUNK_BYTES,
         };
         let mut mcap = options
-            .create(BufWriter::new(file))
+            .create(BufWriter::new(sink))
             .map_err(|e| writer.write_error(e))?;
 
         let (name, encoding, data) = state_schema()?;
@@ -244,6 +274,14 @@ impl RecordingWriter {
         self.write_metadata(SUMMARY_METADATA_NAME, entries)
     }
 
+    /// Writes the metadata record [`INTERRUPTED_METADATA_NAME`] with key `reason` (e.g.
+    /// `SIGINT`): the run was stopped before its end, its last frame is where it stopped.
+    /// Then flushes.
+    pub fn write_interrupted(&mut self, reason: &str) -> Result<(), RecordError> {
+        let entries = BTreeMap::from([("reason".to_string(), reason.to_string())]);
+        self.write_metadata(INTERRUPTED_METADATA_NAME, entries)
+    }
+
     /// Writes the summary section (schemas, channels, statistics, indexes) and the footer,
     /// flushes and syncs the file to disk.
     pub fn finish(mut self) -> Result<(), RecordError> {
@@ -251,11 +289,11 @@ impl RecordingWriter {
             return Ok(());
         };
         mcap.finish().map_err(|e| self.write_error(e))?;
-        let file = mcap
+        let mut sink = mcap
             .into_inner()
             .into_inner()
             .map_err(|e| self.io_error(e.into_error()))?;
-        file.sync_all().map_err(|e| self.io_error(e))
+        sink.sync().map_err(|e| self.io_error(e))
     }
 
     pub(crate) fn mcap(&mut self) -> &mut McapWriter {
@@ -298,10 +336,15 @@ impl RecordingWriter {
         result.map_err(|e| self.write_error(e))
     }
 
+    /// The error of a failed write; an I/O error is reported as such, so that its message
+    /// names the OS error (e.g. `No space left on device (os error 28)`).
     pub(crate) fn write_error(&self, source: mcap::McapError) -> RecordError {
-        RecordError::Write {
-            path: self.path.clone(),
-            source,
+        match source {
+            mcap::McapError::Io(e) => self.io_error(e),
+            source => RecordError::Write {
+                path: self.path.clone(),
+                source,
+            },
         }
     }
 

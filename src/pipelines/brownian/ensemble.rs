@@ -15,7 +15,7 @@ use serde_json::Value;
 
 use super::summary::{RunResult, StartRegions, run_result, summary_of};
 use crate::scene::Scene;
-use crate::sim::{RunOptions, SimError, Simulation};
+use crate::sim::{RunOptions, SimError, Simulation, StopFlag, mark_interrupted, partial};
 
 /// Seed of replicate `k` of a run with `seed`.
 ///
@@ -32,11 +32,26 @@ pub fn replicate_seed(seed: u64, k: u64) -> u64 {
     splitmix64(&mut s)
 }
 
+/// What one replicate left: its result and, for replicate 0, the ensemble's configuration;
+/// or why it failed.
+struct Replicate {
+    result: Option<RunResult>,
+    meta: Option<(StartRegions, BrownianConfig)>,
+    error: Option<SimError>,
+}
+
 /// Run `runs` replicates of `scene` (recording only replicate 0) and summarise them.
 /// `progress` is called with the number of steps just completed (from any thread).
 ///
+/// Every replicate polls `options.stop` between steps; once it is set no further replicate
+/// starts (replicate 0 always runs: its world gives the ensemble's configuration), and the
+/// summary is computed from what ran (the capture curves up to the fewest steps any
+/// replicate made), marked `"interrupted": true`, `"interrupted_by"` and `"runs_requested"`.
+/// A failing replicate stops the others at once.
+///
 /// # Errors
-/// The first replicate's [`SimError`] in replicate order.
+/// The first replicate's [`SimError`] in replicate order, as [`SimError::Partial`] with the
+/// summary of what ran when replicate 0 got as far as its first step.
 pub fn run_ensemble(
     scene: &Scene,
     runs: u64,
@@ -48,7 +63,16 @@ pub fn run_ensemble(
         .seed
         .or(scene.simulation.as_ref().map(|s| s.seed))
         .unwrap_or(0);
-    let one = |k: u64| -> Result<(RunResult, Option<(StartRegions, BrownianConfig)>), SimError> {
+    // The replicates' flag: set by the caller's, or by a failing replicate.
+    let stop = options
+        .stop
+        .as_ref()
+        .map(StopFlag::child)
+        .unwrap_or_default();
+    let one = |k: u64| -> Option<Replicate> {
+        if k > 0 && stop.is_stopped() {
+            return None;
+        }
         let opts = RunOptions {
             seed: Some(replicate_seed(seed, k)),
             record: if k == 0 { options.record.clone() } else { None },
@@ -56,15 +80,29 @@ pub fn run_ensemble(
             single_threaded: options.single_threaded || runs > 1,
             resume_from: None,
             plugins: options.plugins.clone(),
+            stop: Some(stop.clone()),
         };
-        let mut sim = Simulation::from_scene(scene, opts)?;
+        let failed = |e: SimError| {
+            stop.request_stop(format!("replicate {k} failed"));
+            Some(e)
+        };
+        let mut sim = match Simulation::from_scene(scene, opts) {
+            Ok(sim) => sim,
+            Err(e) => {
+                return Some(Replicate {
+                    result: None,
+                    meta: None,
+                    error: failed(e),
+                });
+            }
+        };
         let last = AtomicU64::new(0);
-        sim.run(|w| {
+        let ran = sim.run(|w| {
             let s = w.resource::<StepClock>().step;
             if s % 100 == 0 {
                 progress(s - last.swap(s, Ordering::Relaxed));
             }
-        })?;
+        });
         let w = &sim.app.world;
         progress(w.resource::<StepClock>().step - last.load(Ordering::Relaxed));
         let meta = (k == 0).then(|| {
@@ -75,23 +113,41 @@ pub fn run_ensemble(
                 w.resource::<BrownianConfig>().clone(),
             )
         });
-        Ok((run_result(w, sim.seed), meta))
+        Some(Replicate {
+            result: Some(run_result(w, sim.seed)),
+            meta,
+            error: ran.err().and_then(|e| failed(e.into_cause())),
+        })
     };
-    let results: Vec<_> = (0..runs).into_par_iter().map(one).collect();
-    let mut out = Vec::with_capacity(results.len());
+    let replicates: Vec<_> = (0..runs).into_par_iter().map(one).collect();
+    let mut out = Vec::with_capacity(replicates.len());
     let mut meta = None;
-    for r in results {
-        let (result, m) = r?;
-        if m.is_some() {
-            meta = m;
+    let mut error = None;
+    for r in replicates.into_iter().flatten() {
+        if error.is_none() {
+            error = r.error;
         }
-        out.push(result);
+        if r.meta.is_some() {
+            meta = r.meta;
+        }
+        out.extend(r.result);
     }
-    let (regions, config) = meta.expect("replicate 0 ran");
-    Ok(summary_of(
-        &out,
-        &regions,
-        &config,
-        started.elapsed().as_secs_f64(),
-    ))
+    let Some((regions, config)) = meta else {
+        return Err(error.unwrap_or(SimError::NothingToRun));
+    };
+    let mut summary = summary_of(&out, &regions, &config, started.elapsed().as_secs_f64());
+    let complete = out.len() as u64 == runs && out.iter().all(|r| r.steps >= config.steps);
+    let interrupted = match &error {
+        Some(_) => Some("error".to_string()),
+        None if complete => None,
+        None => Some(stop.reason().unwrap_or_else(|| "stop requested".into())),
+    };
+    if let Some(reason) = interrupted {
+        mark_interrupted(&mut summary, &reason);
+        summary["runs_requested"] = runs.into();
+    }
+    match error {
+        Some(e) => Err(partial(e, summary)),
+        None => Ok(summary),
+    }
 }

@@ -1,0 +1,127 @@
+//! SIGINT and SIGTERM during `magsep run` (the handlers are installed by the CLI only; the
+//! library's side is the [`StopFlag`]).
+//!
+//! The first signal sets the run's stop flag: the current step ends, the final frame is
+//! recorded, the recording is closed with its footer and a `magsep.interrupted` record, the
+//! summary of what ran is printed on stdout marked `"interrupted": true` and
+//! `"interrupted_by": "SIGINT"` (or `"SIGTERM"`), and the process exits with 128 + the signal
+//! number: [`EXIT_SIGINT`] (130) or [`EXIT_SIGTERM`] (143), the shell's convention. A second
+//! signal exits at once, with its own code, leaving the recording as a truncated file whose
+//! finished frames stay readable.
+
+use crate::sim::StopFlag;
+
+/// Exit code of a run stopped by SIGINT (128 + 2).
+pub const EXIT_SIGINT: i32 = 130;
+/// Exit code of a run stopped by SIGTERM (128 + 15).
+pub const EXIT_SIGTERM: i32 = 143;
+
+pub use imp::{SignalGuard, install};
+
+#[cfg(unix)]
+mod imp {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicI32, Ordering};
+    use std::thread::JoinHandle;
+
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::iterator::{Handle, Signals};
+
+    use super::StopFlag;
+    use crate::cli::output::eprint;
+
+    /// The installed handlers: a thread that receives the signals (so nothing runs in signal
+    /// context). Dropping it stops that thread.
+    pub struct SignalGuard {
+        handle: Handle,
+        thread: Option<JoinHandle<()>>,
+        received: Arc<AtomicI32>,
+    }
+
+    fn name(signal: i32) -> &'static str {
+        match signal {
+            SIGINT => "SIGINT",
+            SIGTERM => "SIGTERM",
+            _ => "signal",
+        }
+    }
+
+    /// Handle SIGINT and SIGTERM: the first sets `stop` (reason `SIGINT` or `SIGTERM`), the
+    /// second exits the process at once with 128 + its number.
+    ///
+    /// # Errors
+    /// The OS error when the handlers or their thread cannot be set up.
+    pub fn install(stop: &StopFlag) -> std::io::Result<SignalGuard> {
+        let mut signals = Signals::new([SIGINT, SIGTERM])?;
+        let handle = signals.handle();
+        let received = Arc::new(AtomicI32::new(0));
+        let seen = received.clone();
+        let stop = stop.clone();
+        let thread = std::thread::Builder::new()
+            .name("magsep-signals".into())
+            .spawn(move || {
+                for signal in signals.forever() {
+                    let first = seen
+                        .compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst)
+                        .is_ok();
+                    if !first {
+                        eprint(format!("\nmagsep: {} again: exiting at once", name(signal)));
+                        std::process::exit(128 + signal);
+                    }
+                    eprint(format!(
+                        "\nmagsep: {} received: ending the current step and closing the recording \
+                         (send it again to exit at once)",
+                        name(signal)
+                    ));
+                    stop.request_stop(name(signal));
+                }
+            })?;
+        Ok(SignalGuard {
+            handle,
+            thread: Some(thread),
+            received,
+        })
+    }
+
+    impl SignalGuard {
+        /// The exit code of the first signal received (130, 143), if one was.
+        pub fn exit_code(&self) -> Option<i32> {
+            match self.received.load(Ordering::SeqCst) {
+                0 => None,
+                s => Some(128 + s),
+            }
+        }
+    }
+
+    impl Drop for SignalGuard {
+        fn drop(&mut self) {
+            self.handle.close();
+            if let Some(t) = self.thread.take() {
+                let _ = t.join();
+            }
+        }
+    }
+}
+
+#[cfg(not(unix))]
+mod imp {
+    use super::StopFlag;
+
+    /// No signal handling on this platform (the process ends as the OS decides).
+    pub struct SignalGuard;
+
+    /// Nothing to install on this platform.
+    ///
+    /// # Errors
+    /// Never.
+    pub fn install(_stop: &StopFlag) -> std::io::Result<SignalGuard> {
+        Ok(SignalGuard)
+    }
+
+    impl SignalGuard {
+        /// Always `None`.
+        pub fn exit_code(&self) -> Option<i32> {
+            None
+        }
+    }
+}
