@@ -10,9 +10,7 @@ use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
-use magsep_plugins::record::{
-    FibreShape, PluginInfo, RecordingMetadata, RecordingWriter,
-};
+use magsep_plugins::record::{FibreShape, PluginInfo, RecordingMetadata, RecordingWriter};
 use magsep_plugins::recorder::{Recorder, record_now, recording_error};
 use serde_json::Value;
 

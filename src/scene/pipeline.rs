@@ -179,7 +179,8 @@ pub struct RunOptions {
 ///     .unwrap();
 /// assert_eq!(summary["interrupted"], true);
 /// assert_eq!(summary["interrupted_by"], "enough steps");
-/// let steps = &summary["compression_steps"].as_u64().unwrap() + summary["failed_steps"].as_u64().unwrap();
+/// let steps = summary["compression_steps"].as_u64().unwrap()
+///     + summary["failed_steps"].as_u64().unwrap();
 /// assert_eq!(steps, 3);
 /// ```
 #[derive(Clone, Debug, Default)]

@@ -8,11 +8,11 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use magsep::bevy_ecs::world::World;
 use magsep::plugins::record::{
     INTERRUPTED_METADATA_NAME, RecordingMetadata, RecordingSink, RecordingWriter, read_recording,
     read_recording_bytes,
 };
-use magsep::bevy_ecs::world::World;
 use magsep::plugins::recorder::Recorder;
 use magsep::prelude::*;
 use magsep::scene::{NoProgress, Scene, load_scene, parse_scene};
@@ -105,7 +105,10 @@ fn a_run_that_ends_normally_is_not_marked_interrupted() {
 }
 
 fn brownian_long() -> Scene {
-    let path = format!("{}/tests/data/brownian_long.toml", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/tests/data/brownian_long.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
     load_scene(path.as_ref(), &Default::default()).unwrap()
 }
 
@@ -144,7 +147,11 @@ fn a_stop_during_an_ensemble_stops_every_replicate() {
     // 4 replicates of 10^7 steps each: minutes, unless every replicate stops
     let summary = run_scene(&brownian_long(), &options, &NoProgress).unwrap();
     timer.join().unwrap();
-    assert!(start.elapsed() < Duration::from_secs(30), "{:?}", start.elapsed());
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "{:?}",
+        start.elapsed()
+    );
     assert_eq!(summary["interrupted_by"], "timer", "{summary}");
     assert!(summary["steps"].as_u64().unwrap() < 10_000_000, "{summary}");
     let rec = read_recording(&path).unwrap();
@@ -207,13 +214,11 @@ fn a_write_failure_stops_the_run_at_that_step_and_keeps_what_was_written_readabl
         message.contains(&format!("frame at step {last}")),
         "stopped at step {last}, after the failing frame: {message}"
     );
-    assert!(
-        matches!(err.cause(), SimError::RecordWrite(_)),
-        "{err:?}"
-    );
+    assert!(matches!(err.cause(), SimError::RecordWrite(_)), "{err:?}");
     let summary = err.partial_summary().expect("partial summary").clone();
     assert_eq!(summary["interrupted"], true, "{summary}");
-    let steps = summary["compression_steps"].as_u64().unwrap() + summary["failed_steps"].as_u64().unwrap();
+    let steps =
+        summary["compression_steps"].as_u64().unwrap() + summary["failed_steps"].as_u64().unwrap();
     assert_eq!(steps, last, "{summary}");
     assert!(
         summary["run_error"]

@@ -64,8 +64,18 @@ fn finish(mut child: Child, limit: Duration) -> (Output, Duration) {
     let took = start.elapsed();
     let mut stdout = Vec::new();
     let mut stderr = Vec::new();
-    child.stdout.take().unwrap().read_to_end(&mut stdout).unwrap();
-    child.stderr.take().unwrap().read_to_end(&mut stderr).unwrap();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_end(&mut stdout)
+        .unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_end(&mut stderr)
+        .unwrap();
     let status = child.wait().unwrap();
     (
         Output {
@@ -88,7 +98,12 @@ fn wait_for_frames(child: &mut Child, record: &Path, frames: usize) {
         }
         if let Some(status) = child.try_wait().expect("wait") {
             let mut err = String::new();
-            child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
             panic!("magsep exited ({status}) before recording {frames} frames:\n{err}");
         }
         assert!(
@@ -157,10 +172,16 @@ fn sigint_ends_a_packing_run_with_a_partial_summary_and_a_complete_recording() {
     let summary = summary_of(&out);
     assert_eq!(summary["interrupted"], true, "{summary}");
     assert_eq!(summary["interrupted_by"], "SIGINT", "{summary}");
-    let steps = summary["compression_steps"].as_u64().expect("compression_steps")
+    let steps = summary["compression_steps"]
+        .as_u64()
+        .expect("compression_steps")
         + summary["failed_steps"].as_u64().expect("failed_steps");
     assert!(steps >= 2, "{summary}");
-    assert!(stderr(&out).contains("interrupted by SIGINT"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("interrupted by SIGINT"),
+        "{}",
+        stderr(&out)
+    );
     assert!(took < Duration::from_secs(5), "graceful stop took {took:?}");
 
     let info = assert_info_interrupted(&record, "SIGINT");
@@ -212,7 +233,11 @@ fn a_second_signal_exits_at_once() {
     let err = stderr(&out);
     assert!(err.contains("SIGINT again: exiting at once"), "{err}");
     // no graceful end: no summary, and the recording has no footer but its frames are readable
-    assert!(out.stdout.is_empty(), "{}", String::from_utf8_lossy(&out.stdout));
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     assert!(took < Duration::from_secs(2), "exit took {took:?}");
     let rec = read_recording(&record).unwrap();
     assert!(rec.truncated.is_some());
@@ -249,8 +274,8 @@ fn a_write_failure_stops_the_run_at_once_with_exit_1() {
         "{summary}"
     );
     // stopped at the frame that failed: a few steps into a run of thousands
-    let steps = summary["compression_steps"].as_u64().unwrap()
-        + summary["failed_steps"].as_u64().unwrap();
+    let steps =
+        summary["compression_steps"].as_u64().unwrap() + summary["failed_steps"].as_u64().unwrap();
     assert!(steps < 100, "{summary}");
     let size = std::fs::metadata(&record).unwrap().len();
     assert!(size <= 2048 * 1024, "{size}");
