@@ -289,6 +289,9 @@ pub fn num(v: f64) -> String {
     }
 }
 
+/// Viscosities a scene may give \[Pa s\] (a gas to a stiff paste), every pipeline.
+pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
+
 /// Lengths a scene may give \[m\]: particle sizes, regions, containers (every pipeline).
 pub const LENGTH_RANGE: (f64, f64) = (1e-10, 1e3);
 

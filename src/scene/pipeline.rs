@@ -35,6 +35,10 @@ pub struct ParseContext<'a> {
     pub particles: &'a mut Vec<(usize, ParticleGroup)>,
     /// `[[fibres]]` (and expanded `[[fibre_packings]]`).
     pub fibres: &'a [FibreSpec],
+    /// Whether every `[[fibres]]` and `[[fibre_packings]]` entry is valid. When one is not
+    /// (its errors are reported), indices into [`fibres`](Self::fibres) are unreliable:
+    /// skip the checks of fibre references rather than report spurious ones.
+    pub fibres_valid: bool,
     /// Errors found so far; push more.
     pub errors: &'a mut Vec<SceneError>,
 }

@@ -113,6 +113,22 @@ impl DensityRatios {
     }
 }
 
+/// An error at `{path}.positions[j]` for the first pair of explicit centres (of spheres of
+/// `radius` \[m\]) that would start overlapping (see [`first_overlap`]).
+pub fn check_overlap(
+    path: &str,
+    positions: &[[f64; 3]],
+    radius: f64,
+    errors: &mut Vec<super::SceneError>,
+) {
+    if let Some((a, b)) = first_overlap(positions, radius) {
+        errors.push(super::SceneError::new(
+            format!("{path}.positions[{b}]"),
+            format!("overlaps positions[{a}]: centres closer than a diameter"),
+        ));
+    }
+}
+
 /// The first pair (i < j, by j then i) of explicit centres closer than `2 radius` \[m\]: two
 /// spheres that would start overlapping. A sweep along x after sorting, O(n log n) for
 /// spread points.

@@ -328,12 +328,22 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
     }
     // fibres from packing recordings, appended after the explicit ones (reported under
     // fibre_packings[i] when invalid)
+    let entries = |key: &str| {
+        table
+            .get(key)
+            .and_then(|v| v.as_array())
+            .map_or(0, Vec::len)
+    };
+    let before = errors.len();
+    let typed_all =
+        fibres.len() == entries("fibres") && fibre_packings.len() == entries("fibre_packings");
     for (i, spec) in &fibre_packings {
         let first = fibres.len();
         for f in super::fibre_packing::expand(*i, spec, &mut errors) {
             fibres.push((first, f));
         }
     }
+    let fibres_valid = typed_all && errors.len() == before;
     let fibre_specs: Vec<FibreSpec> = fibres.iter().map(|(_, f)| f.clone()).collect();
     // particle keys of other pipelines, and keys nobody reads
     let accepted: &[&str] = pipeline.as_ref().map(|p| p.particle_keys()).unwrap_or(&[]);
@@ -369,6 +379,7 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
             ));
         }
         let mut cx = ParseContext {
+            fibres_valid,
             table: &table,
             particles: &mut particles,
             fibres: &fibre_specs,

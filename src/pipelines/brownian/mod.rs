@@ -46,7 +46,7 @@ impl Pipeline for BrownianPipeline {
         // again; auto takes Cholesky up to N = 300, a dense operator above
         let n = scene.total_particles() as f64;
         let dense = 72.0 * n * n;
-        let hydro = match section.config().mobility {
+        let hydro = match section.mobility.unwrap_or_default() {
             MobilityChoice::FreeDraining => 0.0,
             MobilityChoice::Cholesky => 2.0 * dense,
             _ => dense,
@@ -99,11 +99,7 @@ impl Pipeline for BrownianPipeline {
         if let Some(b) = &section {
             scene::validate_section(b, cx.errors);
         }
-        let fibre_errors = cx
-            .errors
-            .iter()
-            .any(|e| e.path.starts_with("fibres") || e.path.starts_with("fibre_packings"));
-        let fibres = (!fibre_errors).then_some(cx.fibres);
+        let fibres = cx.fibres_valid.then_some(cx.fibres);
         for (i, g) in cx.particles.iter() {
             let p = format!("particles[{i}]");
             match g.shape {

@@ -39,14 +39,12 @@ use magsep_components::brownian::{
 };
 use serde::{Deserialize, Serialize};
 
-use crate::scene::checks::{LENGTH_RANGE, num, within};
+use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, num, within};
 use crate::scene::{FibreSpec, PlacementSpec, SceneError};
 
 /// Temperatures accepted \[K\] (a temperature near 0 switches the noise off, for
 /// deterministic checks).
 pub const TEMPERATURE_RANGE: (f64, f64) = (1e-20, 1e4);
-/// Viscosities accepted \[Pa s\] (a gas to a stiff paste).
-pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
 /// The largest magnetisation a particle's moment may imply \[A/m\]: m / V at most this
 /// (iron saturates at 1.7e6 A/m; no material exceeds 2e6 A/m).
 pub const MAX_MAGNETISATION: f64 = 2e6;
@@ -370,12 +368,7 @@ pub fn validate_group(
                     format!("must be three finite numbers in [-{MAX_REGION}, {MAX_REGION}] [m]"),
                 ));
             }
-            if let Some((a, b)) = crate::scene::placement::first_overlap(positions, radius) {
-                errors.push(SceneError::new(
-                    format!("{q}.positions[{b}]"),
-                    format!("overlaps positions[{a}]: centres closer than a diameter"),
-                ));
-            }
+            crate::scene::placement::check_overlap(&q, positions, radius, errors);
         }
     }
 }

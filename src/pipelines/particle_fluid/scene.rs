@@ -46,9 +46,7 @@ use magsep_systems::fluid::flow::FlowModel;
 use magsep_systems::fluid::magnet::{Liquid, MagnetModel};
 use serde::{Deserialize, Serialize};
 
-pub use super::validate::{
-    DENSITY_RANGE, MAX_EXTENT, MAX_FIELD, MAX_RATE, MAX_SPEED, VISCOSITY_RANGE, validate,
-};
+pub use super::validate::{DENSITY_RANGE, MAX_EXTENT, MAX_FIELD, MAX_RATE, MAX_SPEED, validate};
 
 /// `[particle_fluid]`: every key but `time_step` and `duration` optional.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -7,13 +7,11 @@ use magsep_systems::fluid::config::HistoryChoice;
 use magsep_systems::fluid::flow::FlowModel;
 
 use super::scene::{FluidContainerSpec, ParticleFluidScene, count_from_volume_fraction};
-use crate::scene::checks::{LENGTH_RANGE, check, finite_positive, within};
+use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, check, finite_positive, within};
 use crate::scene::{ParticleGroup, PlacementSpec, SceneError, ShapeSpec};
 
 /// Densities accepted, of liquids and particles \[kg/m³\] (osmium is 22.6e3).
 pub const DENSITY_RANGE: (f64, f64) = (1.0, 3e4);
-/// Viscosities accepted \[Pa s\].
-pub const VISCOSITY_RANGE: (f64, f64) = (1e-6, 1e4);
 /// Largest container edge, magnet size or position \[m\].
 pub const MAX_EXTENT: f64 = 100.0;
 /// Largest magnet surface field \[A/m\] (the strongest permanent magnets give about 1e6).
@@ -314,12 +312,7 @@ fn validate_group(
                     format!("must be finite and inside the container, got {x:?}")
                 });
             }
-            if let Some((a, b)) = crate::scene::placement::first_overlap(positions, radius) {
-                errors.push(SceneError::new(
-                    format!("{q}.positions[{b}]"),
-                    format!("overlaps positions[{a}]: centres closer than a diameter"),
-                ));
-            }
+            crate::scene::placement::check_overlap(&q, positions, radius, errors);
         }
         Some(PlacementSpec::Injection {
             heavy,
