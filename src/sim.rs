@@ -361,14 +361,11 @@ fn open_recording(
         .map(|(id, s)| (*id, *s))
         .collect();
     shapes.sort_by_key(|r| r.0);
-    if shapes.iter().any(|r| r.1.is_superquadric()) {
+    if shapes.iter().any(|r| r.1.as_superquadric().is_some()) {
         writer.set_semi_axes(
             shapes
                 .iter()
-                .map(|r| match r.1 {
-                    Shape::Superquadric { semi_axes, .. } => semi_axes,
-                    _ => glam::DVec3::ZERO,
-                })
+                .map(|r| r.1.as_superquadric().map(|s| s.0).unwrap_or_default())
                 .collect(),
         );
     }

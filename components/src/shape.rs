@@ -30,6 +30,15 @@ pub enum Shape {
         /// Shape exponents (g1, g2, g3), each >= 2 (strictly convex), dimensionless.
         exponents: DVec3,
     },
+    /// A spheroid (ellipsoid of revolution) about body z: x²/a² + y²/a² + z²/c² <= 1. Oblate
+    /// (a flake or disc) for c < a, prolate for c > a. Its aspect ratio in the sense of thesis
+    /// 002 is w = d_minor/d_major = c/a for an oblate spheroid.
+    Spheroid {
+        /// Equatorial semi-axis a (along body x and y) \[m\].
+        equatorial_radius: f64,
+        /// Polar semi-axis c (along the symmetry axis, body z) \[m\].
+        polar_radius: f64,
+    },
 }
 
 impl Shape {
@@ -39,13 +48,17 @@ impl Shape {
         match *self {
             Shape::Sphere { radius } | Shape::Spherocylinder { radius, .. } => radius,
             Shape::Superquadric { semi_axes, .. } => semi_axes.min_element(),
+            Shape::Spheroid {
+                equatorial_radius,
+                polar_radius,
+            } => equatorial_radius.min(polar_radius),
         }
     }
 
     /// Half length of the axis segment \[m\]; zero for a sphere and a superquadric.
     pub fn half_length(&self) -> f64 {
         match *self {
-            Shape::Sphere { .. } | Shape::Superquadric { .. } => 0.0,
+            Shape::Sphere { .. } | Shape::Superquadric { .. } | Shape::Spheroid { .. } => 0.0,
             Shape::Spherocylinder { half_length, .. } => half_length,
         }
     }
@@ -55,13 +68,38 @@ impl Shape {
         matches!(self, Shape::Superquadric { .. })
     }
 
+    /// Whether this is a spheroid.
+    pub fn is_spheroid(&self) -> bool {
+        matches!(self, Shape::Spheroid { .. })
+    }
+
+    /// The semi-axes and exponents of the shape as a superquadric, if it is one (a spheroid is
+    /// the superquadric (a, a, c) with exponents 2).
+    pub fn as_superquadric(&self) -> Option<(DVec3, DVec3)> {
+        match *self {
+            Shape::Superquadric {
+                semi_axes,
+                exponents,
+            } => Some((semi_axes, exponents)),
+            Shape::Spheroid {
+                equatorial_radius: a,
+                polar_radius: c,
+            } => Some((DVec3::new(a, a, c), DVec3::splat(2.0))),
+            _ => None,
+        }
+    }
+
     /// Aspect ratio (L + D) / D (thesis 000, eq. 2.1); 1 for a sphere; largest over smallest
-    /// semi-axis for a superquadric.
+    /// semi-axis for a superquadric or a spheroid (1/w for an oblate spheroid).
     pub fn aspect_ratio(&self) -> f64 {
         match *self {
             Shape::Superquadric { semi_axes, .. } => {
                 semi_axes.max_element() / semi_axes.min_element()
             }
+            Shape::Spheroid {
+                equatorial_radius: a,
+                polar_radius: c,
+            } => a.max(c) / a.min(c),
             _ => 1.0 + self.half_length() / self.radius(),
         }
     }

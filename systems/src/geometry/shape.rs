@@ -37,6 +37,13 @@ use super::superquadric::{
 /// assert!((v - 4.0 / 3.0 * std::f64::consts::PI).abs() < 1e-15);
 /// ```
 pub fn volume(shape: &Shape) -> f64 {
+    if let Shape::Spheroid {
+        equatorial_radius: a,
+        polar_radius: c,
+    } = *shape
+    {
+        return 4.0 / 3.0 * PI * a * a * c;
+    }
     if let Shape::Superquadric {
         semi_axes,
         exponents,
@@ -60,6 +67,16 @@ pub fn volume(shape: &Shape) -> f64 {
 /// assert!((i.x - 0.4 * volume(&s) * 0.25).abs() < 1e-15);
 /// ```
 pub fn inertia_body_unit_density(shape: &Shape) -> DVec3 {
+    if let Shape::Spheroid {
+        equatorial_radius: a,
+        polar_radius: c,
+    } = *shape
+    {
+        // the solid ellipsoid: I_x = I_y = m (a² + c²)/5, I_z = 2 m a²/5
+        let m = volume(shape);
+        let ix = m * (a * a + c * c) / 5.0;
+        return DVec3::new(ix, ix, 0.4 * m * a * a);
+    }
     if let Shape::Superquadric {
         semi_axes,
         exponents,
@@ -95,6 +112,10 @@ pub fn bounding_radius(shape: &Shape) -> f64 {
             semi_axes,
             exponents,
         } => superquadric_bounding_radius(semi_axes, exponents),
+        Shape::Spheroid {
+            equatorial_radius,
+            polar_radius,
+        } => equatorial_radius.max(polar_radius),
         _ => shape.radius() + shape.half_length(),
     }
 }

@@ -47,13 +47,13 @@ impl Body {
                 radius: radius / d,
                 half_length: half_length / d,
             },
-            Shape::Superquadric {
-                semi_axes,
-                exponents,
-            } => Shape::Superquadric {
-                semi_axes: semi_axes / d,
-                exponents,
-            },
+            Shape::Superquadric { .. } | Shape::Spheroid { .. } => {
+                let (semi_axes, exponents) = shape.as_superquadric().unwrap_or_default();
+                Shape::Superquadric {
+                    semi_axes: semi_axes / d,
+                    exponents,
+                }
+            }
         };
         let v = volume(&scaled);
         let inertia = inertia_body_unit_density(&scaled);

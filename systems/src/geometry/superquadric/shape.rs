@@ -64,6 +64,10 @@ impl Superquadric {
                 exponents,
             }),
             Shape::Sphere { radius } => Some(Self::superball(radius, 2.0)),
+            Shape::Spheroid { .. } => shape.as_superquadric().map(|(semi_axes, exponents)| Self {
+                semi_axes,
+                exponents,
+            }),
             Shape::Spherocylinder { .. } => None,
         }
     }
