@@ -142,7 +142,8 @@ impl SimPlugin for InertialIntegratorPlugin {
             contributions: Consumption::Consumed,
             kernels: Consumption::Consumed,
         });
-        app.insert_on_particles(StepStart::default());
+        app.insert_on_particles(StepStart::default())
+            .insert_on_particles(StepStartOrientation::default());
         app.schedule.add_systems((
             update_velocities.in_set(SimSystems::Mobility),
             integrate_positions.in_set(SimSystems::Integrate),

@@ -13,7 +13,7 @@
 //! system, from the slip sampled then (a collision in between resets it, eq. 2.29).
 
 use bevy_ecs::prelude::*;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
 
 use super::config::{Integrator, ParticleFluidConfig};
@@ -42,6 +42,11 @@ pub struct PendingHistoryReset(pub Option<(f64, DVec3)>);
 /// Position at the start of the step \[m\] (the collision step re-advances from it).
 #[derive(Component, Debug, Clone, Copy, Default)]
 pub struct StepStart(pub DVec3);
+
+/// Orientation at the start of the step (the collision step re-rotates non-spherical
+/// particles from it).
+#[derive(Component, Debug, Clone, Copy, Default)]
+pub struct StepStartOrientation(pub DQuat);
 
 /// Whether the flow needs sampling (run condition).
 pub fn flow_is_not_quiescent(cfg: Res<ParticleFluidConfig>) -> bool {
@@ -247,11 +252,13 @@ pub fn integrate_positions(
         &mut Position,
         &mut Orientation,
         &mut StepStart,
+        &mut StepStartOrientation,
     )>,
 ) {
     let dt = cfg.dt;
-    q.par_iter_mut().for_each(|(v, w, mut x, mut o, mut s)| {
+    q.par_iter_mut().for_each(|(v, w, mut x, mut o, mut s, mut so)| {
         s.0 = x.0;
+        so.0 = o.0;
         x.0 += dt * v.0;
         o.0 = rotate(o.0, w.0, dt);
     });
