@@ -8,6 +8,7 @@
 //! * [`drag`]: Schiller-Naumann and rotational (Dennis) drag with implicit stiffnesses.
 //! * [`flow`]: prescribed undisturbed flows (one-way coupling).
 //! * [`motion`]: the equation of motion and its (linearly implicit or explicit) Euler step.
+//! * [`rigid`]: quaternion kinematics and Euler's equations of axisymmetric bodies.
 //! * [`single`]: one sphere moving vertically (the thesis's reduced 1-D system).
 //! * [`systems`], [`collide`]: the thin ECS systems of the particle-fluid pipeline.
 //! * [`observe`]: the separation error e_m (eq. 2.51).
@@ -26,6 +27,7 @@ pub mod levitation;
 pub mod magnet;
 pub mod motion;
 pub mod observe;
+pub mod rigid;
 pub mod single;
 pub mod stokes_reference;
 pub mod systems;
