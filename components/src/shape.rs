@@ -63,9 +63,9 @@ impl Shape {
         }
     }
 
-    /// Whether this is a superquadric.
+    /// Whether this is a superquadric (a spheroid is one, with exponents 2).
     pub fn is_superquadric(&self) -> bool {
-        matches!(self, Shape::Superquadric { .. })
+        matches!(self, Shape::Superquadric { .. } | Shape::Spheroid { .. })
     }
 
     /// Whether this is a spheroid.

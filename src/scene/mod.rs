@@ -40,7 +40,10 @@ pub use pipeline::{
     NoProgress, ParseContext, Pipeline, Progress, Registry, RunInfo, RunOptions, SceneSection,
 };
 pub use placement::{DensityRatios, PlacementSpec};
-pub use sections::{GROUP_KEYS, ParticleGroup, RecordSection, ShapeSpec, SimulationSection};
+pub use sections::{
+    GROUP_KEYS, OrientationSpec, ParticleGroup, RecordSection, ShapeSpec, SimulationSection,
+    spheroid_semi_axes,
+};
 pub use spawn::{RecordEvery, SceneText, spawn_scene, spawn_scene_with};
 
 /// A scene entity kind contributed by a plugin: a top-level key of the scene file.

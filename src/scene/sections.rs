@@ -54,6 +54,81 @@ pub enum ShapeSpec {
         /// Semi-axes (a1, a2, a3) \[m\]. Range: each > 0.
         semi_axes: [f64; 3],
     },
+    /// Spheroid about body z (a flake: oblate, aspect ratio w = d_minor/d_major < 1). Give
+    /// exactly one of: `equatorial_radius` and `polar_radius`; `major_diameter` and
+    /// `aspect_ratio`; `equivalent_diameter` and `aspect_ratio` (d_e = d_major w^{1/3}, the
+    /// volume-equivalent sphere's diameter).
+    Spheroid {
+        /// Equatorial semi-axis a \[m\].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        equatorial_radius: Option<f64>,
+        /// Polar semi-axis c (along the symmetry axis) \[m\].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        polar_radius: Option<f64>,
+        /// d_major = 2a \[m\].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        major_diameter: Option<f64>,
+        /// Volume-equivalent diameter d_e = 2 (a² c)^{1/3} \[m\].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        equivalent_diameter: Option<f64>,
+        /// w = c/a (d_minor/d_major for an oblate spheroid) [-].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        aspect_ratio: Option<f64>,
+    },
+}
+
+/// The semi-axes (a, c) \[m\] of a spheroid given by any one of the scene's three forms
+/// (`None` unless exactly one form is complete and nothing else is given).
+///
+/// ```
+/// use magsep::scene::spheroid_semi_axes;
+/// // the thesis's 1:10 flake of d_e = 4 mm has d_major = 8.62 mm
+/// let (a, c) = spheroid_semi_axes(None, None, None, Some(4e-3), Some(0.1)).unwrap();
+/// assert!((2.0 * a - 8.618e-3).abs() < 1e-6 && (c / a - 0.1).abs() < 1e-15);
+/// assert!(spheroid_semi_axes(Some(1.0), None, None, None, Some(0.5)).is_none());
+/// ```
+pub fn spheroid_semi_axes(
+    equatorial_radius: Option<f64>,
+    polar_radius: Option<f64>,
+    major_diameter: Option<f64>,
+    equivalent_diameter: Option<f64>,
+    aspect_ratio: Option<f64>,
+) -> Option<(f64, f64)> {
+    match (
+        equatorial_radius,
+        polar_radius,
+        major_diameter,
+        equivalent_diameter,
+        aspect_ratio,
+    ) {
+        (Some(a), Some(c), None, None, None) => Some((a, c)),
+        (None, None, Some(d), None, Some(w)) => Some((0.5 * d, 0.5 * d * w)),
+        (None, None, None, Some(de), Some(w)) => {
+            let a = 0.5 * de / w.cbrt();
+            Some((a, w * a))
+        }
+        _ => None,
+    }
+}
+
+/// The initial orientation of a group's particles (`orientation = "broadside"`, `"random"`,
+/// `"edge_on"`, `{ axis = [x, y, z] }` or `{ tilt = 30.0 }`). Only non-spherical particles
+/// care.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum OrientationSpec {
+    /// Symmetry axis vertical (z): a flake lies flat, its broad side facing a vertical motion
+    /// (the thesis's injection, §4.3.2). Default.
+    #[default]
+    Broadside,
+    /// Symmetry axis along x: a flake stands on its edge.
+    EdgeOn,
+    /// Uniformly random orientations (from each particle's random stream).
+    Random,
+    /// Symmetry axis along this lab vector (normalised).
+    Axis([f64; 3]),
+    /// Symmetry axis tilted from vertical by this angle [degrees] about the x axis.
+    Tilt(f64),
 }
 
 impl ShapeSpec {
@@ -86,6 +161,26 @@ impl ShapeSpec {
                 semi_axes: DVec3::from_array(semi_axes),
                 exponents: DVec3::splat(2.0),
             },
+            ShapeSpec::Spheroid {
+                equatorial_radius,
+                polar_radius,
+                major_diameter,
+                equivalent_diameter,
+                aspect_ratio,
+            } => {
+                let (a, c) = spheroid_semi_axes(
+                    equatorial_radius,
+                    polar_radius,
+                    major_diameter,
+                    equivalent_diameter,
+                    aspect_ratio,
+                )
+                .unwrap_or((f64::NAN, f64::NAN));
+                Shape::Spheroid {
+                    equatorial_radius: a,
+                    polar_radius: c,
+                }
+            }
         }
     }
 }
@@ -114,6 +209,9 @@ pub struct ParticleGroup {
     /// Initial velocity [m/s] (particle_fluid). Default zero.
     #[serde(default)]
     pub velocity: Option<[f64; 3]>,
+    /// Initial orientation of non-spherical particles (particle_fluid). Default broadside.
+    #[serde(default)]
+    pub orientation: Option<OrientationSpec>,
     /// Volume fraction Φ of the container instead of `count`: count = floor(Φ V / V_p)
     /// (particle_fluid).
     #[serde(default)]
@@ -134,6 +232,7 @@ pub const GROUP_KEYS: &[&str] = &[
     "density",
     "density_ratios",
     "velocity",
+    "orientation",
     "volume_fraction",
 ];
 

@@ -107,6 +107,52 @@ fn shape_checks(p: &str, shape: &ShapeSpec, errors: &mut Vec<SceneError>) {
             let (big, small) = min_max(&semi_axes);
             ratio(errors, "semi_axes", big, small);
         }
+        ShapeSpec::Spheroid {
+            equatorial_radius,
+            polar_radius,
+            major_diameter,
+            equivalent_diameter,
+            aspect_ratio,
+        } => {
+            let given = [
+                ("equatorial_radius", equatorial_radius),
+                ("polar_radius", polar_radius),
+                ("major_diameter", major_diameter),
+                ("equivalent_diameter", equivalent_diameter),
+            ];
+            for (key, v) in given {
+                if let Some(v) = v {
+                    length(errors, key, v);
+                }
+            }
+            if let Some(w) = aspect_ratio {
+                within(
+                    errors,
+                    &format!("{p}.shape.aspect_ratio"),
+                    w,
+                    1.0 / MAX_SIZE_RATIO,
+                    MAX_SIZE_RATIO,
+                    "[-]",
+                );
+            }
+            match super::sections::spheroid_semi_axes(
+                equatorial_radius,
+                polar_radius,
+                major_diameter,
+                equivalent_diameter,
+                aspect_ratio,
+            ) {
+                Some((a, c)) => {
+                    let (big, small) = (a.max(c), a.min(c));
+                    ratio(errors, "polar_radius", big, small);
+                }
+                None => errors.push(SceneError::new(
+                    format!("{p}.shape"),
+                    "give exactly one of: equatorial_radius and polar_radius; major_diameter \
+                     and aspect_ratio; equivalent_diameter and aspect_ratio",
+                )),
+            }
+        }
         ShapeSpec::Spherocylinder {
             radius,
             cylinder_length,

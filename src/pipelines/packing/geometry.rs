@@ -17,7 +17,10 @@ use crate::scene::{ParticleGroup, SceneError, ShapeSpec};
 fn is_superquadric(s: &ShapeSpec) -> bool {
     matches!(
         s,
-        ShapeSpec::Superquadric { .. } | ShapeSpec::Superball { .. } | ShapeSpec::Ellipsoid { .. }
+        ShapeSpec::Superquadric { .. }
+            | ShapeSpec::Superball { .. }
+            | ShapeSpec::Ellipsoid { .. }
+            | ShapeSpec::Spheroid { .. }
     )
 }
 

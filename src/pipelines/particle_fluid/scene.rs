@@ -280,9 +280,8 @@ impl ParticleFluidScene {
     }
 }
 
-/// Number of particles of a group given by `volume_fraction`: floor(Φ V_fluid / V_p)
-/// (thesis table 2.4: 8835, 70685, 17671).
-pub fn count_from_volume_fraction(fraction: f64, fluid_volume: f64, radius: f64) -> u64 {
-    let vp = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
-    (fraction * fluid_volume / vp).floor() as u64
+/// Number of particles of a group given by `volume_fraction`: floor(Φ V_fluid / V_p) for
+/// particles of volume `particle_volume` \[m³\] (thesis table 2.4: 8835, 70685, 17671).
+pub fn count_from_volume_fraction(fraction: f64, fluid_volume: f64, particle_volume: f64) -> u64 {
+    (fraction * fluid_volume / particle_volume).floor() as u64
 }

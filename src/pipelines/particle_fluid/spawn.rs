@@ -3,18 +3,19 @@
 //! walls as boundary entities, and the pipeline's resources.
 
 use bevy_ecs::prelude::*;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
 use magsep_systems::collision::{CollisionDomain, Plane};
 use magsep_systems::fluid::collide::CollisionWorkspace;
 use magsep_systems::fluid::config::ParticleFluidConfig;
 use magsep_systems::fluid::systems::FluidDomain;
+use magsep_systems::geometry::bounding_radius;
 use magsep_systems::rng::particle_stream;
 use rand::RngExt;
 use std::collections::HashMap;
 
 use super::scene::{FluidContainerSpec, ParticleFluidScene};
-use crate::scene::{PlacementSpec, Scene, SpawnError};
+use crate::scene::{OrientationSpec, PlacementSpec, Scene, SpawnError};
 
 /// Rejection attempts per particle before a region is declared too full.
 const MAX_ATTEMPTS: usize = 100_000;
@@ -60,6 +61,29 @@ impl Placed {
         let k = self.key(self.domain.wrap(x));
         self.grid.entry(k).or_default().push(self.spheres.len());
         self.spheres.push((x, r));
+    }
+}
+
+/// The orientation (body → lab, symmetry axis body z) of a particle that starts as `spec`;
+/// `Random` draws a uniform rotation from `rng` (Shoemake's method).
+pub fn initial_orientation(spec: OrientationSpec, rng: &mut impl RngExt) -> DQuat {
+    match spec {
+        OrientationSpec::Broadside => DQuat::IDENTITY,
+        OrientationSpec::EdgeOn => DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2),
+        OrientationSpec::Axis(v) => DQuat::from_rotation_arc(DVec3::Z, DVec3::from_array(v).normalize()),
+        OrientationSpec::Tilt(deg) => DQuat::from_rotation_x(deg.to_radians()),
+        OrientationSpec::Random => {
+            let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+            let tau = std::f64::consts::TAU;
+            let (s1, s2) = ((1.0 - u1).sqrt(), u1.sqrt());
+            DQuat::from_xyzw(
+                s1 * (tau * u2).sin(),
+                s1 * (tau * u2).cos(),
+                s2 * (tau * u3).sin(),
+                s2 * (tau * u3).cos(),
+            )
+            .normalize()
+        }
     }
 }
 
@@ -116,7 +140,7 @@ pub fn spawn_particle_fluid(
     let d_max = scene
         .particles
         .iter()
-        .map(|g| 2.0 * g.shape.shape().radius())
+        .map(|g| 2.0 * bounding_radius(&g.shape.shape()))
         .fold(0.0, f64::max);
     let mut placed = Placed {
         cell: d_max.max(1e-300),
@@ -128,7 +152,8 @@ pub fn spawn_particle_fluid(
     let mut id = 0u64;
     for (g, group) in scene.particles.iter().enumerate() {
         let shape = group.shape.shape();
-        let r = shape.radius();
+        // placement keeps the bounding spheres apart
+        let r = bounding_radius(&shape);
         let Some(placement) = &group.placement else {
             continue;
         };
@@ -199,11 +224,19 @@ pub fn spawn_particle_fluid(
             };
             placed.insert(x, r);
             let v0 = DVec3::from_array(group.velocity.unwrap_or([0.0; 3]));
+            let orientation = initial_orientation(group.orientation.unwrap_or_default(), &mut rng);
+            let body = match shape {
+                Shape::Spheroid {
+                    equatorial_radius,
+                    polar_radius,
+                } => InertialBody::spheroid(equatorial_radius, polar_radius, rho_p),
+                _ => InertialBody::sphere(r, rho_p),
+            };
             world.spawn((
                 ParticleBundle {
                     id: ParticleId(id),
                     position: Position(x),
-                    orientation: Orientation::default(),
+                    orientation: Orientation(orientation),
                     shape,
                     species: Species(g as u32),
                     rng: ParticleRng(rng),
@@ -212,7 +245,7 @@ pub fn spawn_particle_fluid(
                 },
                 Velocity(v0),
                 AngularVelocity::default(),
-                InertialBody::sphere(r, rho_p),
+                body,
                 cfg.flow.sample(x, 0.0),
                 Levitation {
                     equilibrium_height: cfg.equilibrium_height(rho_p).unwrap_or(f64::NAN),

@@ -8,10 +8,16 @@ use magsep_systems::fluid::flow::FlowModel;
 
 use super::scene::{FluidContainerSpec, ParticleFluidScene, count_from_volume_fraction};
 use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, check, finite_positive, within};
-use crate::scene::{ParticleGroup, PlacementSpec, SceneError, ShapeSpec};
+use magsep_components::shape::Shape;
+
+use crate::scene::checks::num;
+use crate::scene::{OrientationSpec, ParticleGroup, PlacementSpec, SceneError};
 
 /// Densities accepted, of liquids and particles \[kg/m³\] (osmium is 22.6e3).
 pub const DENSITY_RANGE: (f64, f64) = (1.0, 3e4);
+/// Smallest spheroid aspect ratio w = c/a: the flattest shape with drag data (the thesis's
+/// 1:10 database).
+pub const MIN_ASPECT_RATIO: f64 = 0.1;
 /// Largest container edge, magnet size or position \[m\].
 pub const MAX_EXTENT: f64 = 100.0;
 /// Largest magnet surface field \[A/m\] (the strongest permanent magnets give about 1e6).
@@ -181,7 +187,7 @@ pub fn validate(
     }
     let d_max = groups
         .iter()
-        .map(|(_, g)| 2.0 * g.shape.shape().radius())
+        .map(|(_, g)| 2.0 * magsep_systems::geometry::bounding_radius(&g.shape.shape()))
         .fold(0.0, f64::max);
     if bounded && edges.min_element() > 0.0 {
         check(errors, edges.min_element() > d_max, "container", || {
@@ -215,13 +221,52 @@ fn validate_group(
     errors: &mut Vec<SceneError>,
 ) {
     let p = format!("particles[{i}]");
-    let ShapeSpec::Sphere { radius } = g.shape else {
-        errors.push(SceneError::new(
-            format!("{p}.shape.kind"),
-            "the particle_fluid pipeline simulates spheres (spheroids come later)",
-        ));
-        return;
+    // the bounding radius: placement and overlap checks treat a spheroid as its sphere
+    let radius = match g.shape.shape() {
+        Shape::Sphere { radius } => radius,
+        Shape::Spheroid {
+            equatorial_radius: a,
+            polar_radius: c,
+        } => {
+            let w = c / a;
+            check(
+                errors,
+                !(w > 1.0 + 1e-12 || w < MIN_ASPECT_RATIO),
+                &format!("{p}.shape"),
+                || {
+                    format!(
+                        "the particle_fluid pipeline simulates oblate spheroids with aspect \
+                         ratio w = polar/equatorial radius in [{MIN_ASPECT_RATIO}, 1] (the \
+                         range of its drag data), got w = {}",
+                        num(w)
+                    )
+                },
+            );
+            a.max(c)
+        }
+        _ => {
+            errors.push(SceneError::new(
+                format!("{p}.shape.kind"),
+                "the particle_fluid pipeline simulates spheres and spheroids",
+            ));
+            return;
+        }
     };
+    if let Some(o) = g.orientation {
+        let ok = match o {
+            OrientationSpec::Axis(v) => {
+                v.iter().all(|c| c.is_finite() && c.abs() <= 1e6)
+                    && v.iter().map(|c| c * c).sum::<f64>() > 1e-24
+            }
+            OrientationSpec::Tilt(deg) => deg.is_finite() && deg.abs() <= 180.0,
+            _ => true,
+        };
+        check(errors, ok, &format!("{p}.orientation"), || {
+            "must be \"broadside\", \"edge_on\", \"random\", { axis = [x, y, z] } (non-zero, \
+             finite) or { tilt = degrees } in [-180, 180]"
+                .into()
+        });
+    }
     match (g.density, &g.density_ratios) {
         (Some(rho), None) => {
             let (lo, hi) = DENSITY_RANGE;
@@ -269,7 +314,8 @@ fn validate_group(
                 "give count or volume_fraction, not both".into()
             });
             if bounded && phi > 0.0 && radius > 0.0 {
-                g.count = count_from_volume_fraction(phi, pf.container.volume(), radius);
+                let vp = magsep_systems::geometry::volume(&g.shape.shape());
+                g.count = count_from_volume_fraction(phi, pf.container.volume(), vp);
                 check(
                     errors,
                     g.count >= 1,
