@@ -122,8 +122,27 @@ crate::force_contribution!(
     HistoryForce
 );
 
-/// Steady drag (Schiller-Naumann or Stokes) F_D = k (u − v) \[N\] at the start-of-step
-/// velocity, with its stiffness k [kg/s] so that the integrator can treat it implicitly.
+crate::force_contribution!(
+    /// Shape-induced lift of a spheroid at incidence \[N\] (F_PL of thesis 002, eq. 4.6, with
+    /// the corrected direction): perpendicular to the slip, in the plane of the slip and the
+    /// symmetry axis.
+    LiftForce
+);
+crate::torque_contribution!(
+    /// Pitching torque of a spheroid at incidence [N m] (T_P of eq. 4.9, corrected direction):
+    /// turns the symmetry axis towards the slip (broadside).
+    PitchingTorque
+);
+crate::torque_contribution!(
+    /// Magnetic-buoyancy torque [N m] on a non-magnetic spheroid in a paramagnetic liquid
+    /// (T_MB of eq. 4.9, sign corrected): aligns the symmetry axis with the field gradient,
+    /// i.e. turns a flake flat (horizontal) in the thesis's 1-D fields.
+    MagneticTorque
+);
+
+/// Steady drag F_D = k (u − v) \[N\] at the start-of-step velocity (Schiller-Naumann or Stokes
+/// for spheres, the shape correlation for spheroids), with its stiffness k [kg/s] so that the
+/// integrator can treat it implicitly.
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DragForce {
     /// Force \[N\].
@@ -141,8 +160,9 @@ impl ForceContribution for DragForce {
     }
 }
 
-/// Rotational drag torque (Dennis et al.; eq. 2.31 corrected) T = C_T ½ ρ_f R⁵ |Δ| Δ with
-/// Δ = ½ω − Ω [N m], with its stiffness [kg m²/s] for the implicit integrator.
+/// Rotational drag torque [N m] with its stiffness [kg m²/s] for the implicit integrator:
+/// Dennis et al. for spheres (eq. 2.31 corrected), T = C_T ½ ρ_f R⁵ |Δ| Δ with Δ = ½ω − Ω;
+/// Zastawny et al.'s rotational resistance T_R of eq. 4.9 for spheroids.
 #[derive(Component, Debug, Default, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RotationalDragTorque {
     /// Torque [N m].

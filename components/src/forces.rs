@@ -81,6 +81,30 @@ macro_rules! force_contribution {
     };
 }
 
+/// Declare a torque-only contribution component: a newtype over the torque `DVec3` [N m]
+/// that implements [`ForceContribution`] with zero force.
+#[macro_export]
+macro_rules! torque_contribution {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(bevy_ecs::prelude::Component, Debug, Default, Clone, Copy, PartialEq,
+            serde::Serialize, serde::Deserialize)]
+        pub struct $name(pub glam::DVec3);
+
+        impl $crate::forces::ForceContribution for $name {
+            fn force(&self) -> glam::DVec3 {
+                glam::DVec3::ZERO
+            }
+            fn torque(&self) -> glam::DVec3 {
+                self.0
+            }
+            fn clear(&mut self) {
+                self.0 = glam::DVec3::ZERO;
+            }
+        }
+    };
+}
+
 /// The sum of the registered external force kernels at the particle at the start of the step
 /// (a built-in contribution, written by `magsep_systems::forces::compute_kernel_forces` when a
 /// kernel is registered): force \[N\] and torque about the centre [N m]. Pipelines that

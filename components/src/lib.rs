@@ -35,8 +35,8 @@ pub mod prelude {
     pub use crate::fibre::{ExternalField, Fibre, FibreId};
     pub use crate::fluid::{
         AngularVelocity, BuoyancyForce, DragForce, FluidSample, GravityForce, HistoryForce,
-        InertialBody, Levitation, MagneticBuoyancyForce, ParticleFluidStats, RotationalDragTorque,
-        UndisturbedFlowForce, Velocity,
+        InertialBody, Levitation, LiftForce, MagneticBuoyancyForce, MagneticTorque,
+        ParticleFluidStats, PitchingTorque, RotationalDragTorque, UndisturbedFlowForce, Velocity,
     };
     pub use crate::forces::{ForceContribution, NetForce, NetTorque};
     pub use crate::health::Health;

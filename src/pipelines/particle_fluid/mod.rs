@@ -78,6 +78,7 @@ impl Pipeline for ParticleFluidPipeline {
             "density",
             "density_ratios",
             "velocity",
+            "orientation",
             "volume_fraction",
         ]
     }

@@ -70,7 +70,9 @@ pub fn initial_orientation(spec: OrientationSpec, rng: &mut impl RngExt) -> DQua
     match spec {
         OrientationSpec::Broadside => DQuat::IDENTITY,
         OrientationSpec::EdgeOn => DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2),
-        OrientationSpec::Axis(v) => DQuat::from_rotation_arc(DVec3::Z, DVec3::from_array(v).normalize()),
+        OrientationSpec::Axis(v) => {
+            DQuat::from_rotation_arc(DVec3::Z, DVec3::from_array(v).normalize())
+        }
         OrientationSpec::Tilt(deg) => DQuat::from_rotation_x(deg.to_radians()),
         OrientationSpec::Random => {
             let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
