@@ -9,6 +9,8 @@
 //! * [`flow`]: prescribed undisturbed flows (one-way coupling).
 //! * [`motion`]: the equation of motion and its (linearly implicit or explicit) Euler step.
 //! * [`single`]: one sphere moving vertically (the thesis's reduced 1-D system).
+//! * [`spheroid`]: drag, lift, pitching and rotational torques on oblate spheroids (ch. 3-4),
+//!   and the magnetic-buoyancy torque.
 //! * [`systems`], [`collide`]: the thin ECS systems of the particle-fluid pipeline.
 //! * [`observe`]: the separation error e_m (eq. 2.51).
 //! * [`config`]: the pipeline's configuration resource.
@@ -27,5 +29,6 @@ pub mod magnet;
 pub mod motion;
 pub mod observe;
 pub mod single;
+pub mod spheroid;
 pub mod stokes_reference;
 pub mod systems;
