@@ -194,7 +194,7 @@ impl MagnetModel {
     }
 
     /// Magnetic static pressure `p_M(y) = μ₀ ∫₀^H M dH = ½ μ₀ χ H(y)²` \[Pa\] of a liquid of
-    /// susceptibility `chi` ([T002] eq. 4.10 with M = χH).
+    /// susceptibility `chi` ([T002 eq. 4.10] with M = χH).
     pub fn static_pressure(&self, chi: f64, y: f64) -> f64 {
         let (h, _) = self.field(y);
         0.5 * MU0 * chi * h * h

@@ -1,10 +1,10 @@
-//! The 1:10 oblate-spheroid database of [T002] Tables 3.3-3.5 (= [Tajfirooz2021PRE]): 266
+//! The 1:10 oblate-spheroid database of [T002 Tables 3.3-3.5] (= \[Tajfirooz2021PRE\]): 266
 //! steady, body-fixed finite-element solutions, 14 Reynolds numbers × 19 incidence angles.
 //!
 //! Basis, as printed: Re_e = w^{1/3} Re with Re = ρ_f u d_major / μ ∈ {1, 5, 10, 20, …, 120};
 //! coefficients normalised by the volume-equivalent sphere, `C_{·,e} = c_· w^{−2/3}`, with
 //! `c_D = |F_D| / (½ρ_f u² A)`, `c_L = |F_L| / (½ρ_f u² A)`, `c_T = |T_p| / (¼ρ_f u² A d)`,
-//! A = π d_major²/4, d = d_major ([T002] eq. 3.7-3.9). Lift and torque are magnitudes. Rows
+//! A = π d_major²/4, d = d_major ([T002 eq. 3.7-3.9]). Lift and torque are magnitudes. Rows
 //! are φ = 0°, 5°, …, 90° (90° = broadside), columns the 14 Reynolds numbers.
 //!
 //! The values are transcribed exactly as printed, including the 0.01-0.08 entries at φ = 0°

@@ -3,6 +3,7 @@
 use super::correlation_tests::stokes_factors;
 use super::disc_model::*;
 use super::disc_table::*;
+use super::disc_validation::*;
 
 /// Row sums (per angle) and column sums (per Re) of Tables 3.3-3.5 as printed, summed from the
 /// printed text independently of the Rust arrays.

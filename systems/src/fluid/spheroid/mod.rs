@@ -1,21 +1,23 @@
-//! Fluid forces and torques on oblate spheroids: pure kernels ([T002] ch. 3-4 and App. 4.A;
-//! [Sanjeevi2018], [Zastawny2012], [Tajfirooz2021PRE]; see docs/references.md).
+//! Fluid forces and torques on oblate spheroids: pure kernels ([T002 ch. 3-4] and App. 4.A;
+//! \[Sanjeevi2018\], \[Zastawny2012\], \[Tajfirooz2021PRE\]; errata E-002-16, E-002-18,
+//! E-002-22a/b, E-002-26 … E-002-29 and D-002-10 … D-002-13 of docs/references.md).
 //!
 //! A spheroid has semi-axes a, a, c (c = w a, aspect ratio w = c/a <= 1 for the oblate shapes
-//! of [T002]); its symmetry axis is body z, `e` in lab coordinates. magsep's vertical is z
-//! ([T002]'s y), gravity along −z. SI units throughout.
+//! of [T002 ch. 4]); its symmetry axis is body z, `e` in lab coordinates. magsep's vertical is z
+//! (the thesis's y), gravity along −z. SI units throughout.
 //!
 //! * [`correlations`]: the App. 4.A fits (Sanjeevi 2:5, Zastawny 1:5, rotational mode 2) with
 //!   the thesis's typos corrected.
-//! * [`disc_table`]: the 1:10 database of [T002] Tables 3.3-3.5 (266 points).
+//! * [`disc_table`]: the 1:10 database of [T002 Tables 3.3-3.5] (266 points).
 //! * [`disc_model`]: interpolants of that database (the run-time model replaces the thesis's
-//!   neural network, whose weights are not published).
+//!   neural network, whose weights are not published); [`disc_validation`]: their held-out
+//!   errors.
 //! * [`loads`]: [`spheroid_loads`] (drag, lift, pitching torque) and
 //!   [`rotational_resistance`].
 //! * [`magnetic_torque`](mod@magnetic_torque): the torque of the magnetic static pressure on the
 //!   non-spherical surface, closed form and surface quadrature.
 //!
-//! Choice of correlation by aspect ratio ([T002] App. 4.A): w >= 0.99 sphere (Schiller-Naumann,
+//! Choice of correlation by aspect ratio ([T002 App. 4.A]): w >= 0.99 sphere (Schiller-Naumann,
 //! Dennis); 0.3 <= w < 0.99 Sanjeevi 2:5 (the thesis uses it for 1:2 and 2:5); 0.15 <= w < 0.3
 //! Zastawny 1:5; w < 0.15 the 1:10 database. Rotational resistance: Zastawny 5:2 prolate mode 2
 //! for 0.3 <= w < 0.99 (the thesis's choice for 1:2, which it notes over-resists), Zastawny 1:5
@@ -24,6 +26,7 @@
 pub mod correlations;
 pub mod disc_model;
 pub mod disc_table;
+pub mod disc_validation;
 pub mod loads;
 pub mod magnetic_torque;
 
@@ -42,17 +45,17 @@ pub use magnetic_torque::{magnetic_torque, magnetic_torque_quadrature};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-/// Which drag/lift/pitching-torque correlation ([T002] App. 4.A and ch. 3).
+/// Which drag/lift/pitching-torque correlation ([T002 App. 4.A] and ch. 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Correlation {
     /// Schiller-Naumann drag; no lift, no pitching torque.
     Sphere,
-    /// Sanjeevi et al. (2018), 2:5 oblate ([T002] eq. 4.28-4.32, corrected).
+    /// Sanjeevi et al. (2018), 2:5 oblate ([T002 eq. 4.28-4.32], corrected).
     Sanjeevi25,
-    /// Zastawny et al. (2012), 1:5 oblate ([T002] eq. 4.33-4.37, corrected).
+    /// Zastawny et al. (2012), 1:5 oblate ([T002 eq. 4.33-4.37], corrected).
     Zastawny15,
-    /// The 1:10 database of [T002] Tables 3.3-3.5, interpolated ([`disc_model`]).
+    /// The 1:10 database of [T002 Tables 3.3-3.5], interpolated ([`disc_model`]).
     Disc110,
 }
 
@@ -78,7 +81,7 @@ impl Correlation {
     }
 }
 
-/// Which rotational-resistance fit: Dennis (sphere, [T002] eq. 2.32), Zastawny 5:2 prolate
+/// Which rotational-resistance fit: Dennis (sphere, [T002 eq. 2.32]), Zastawny 5:2 prolate
 /// mode 2 (used for 1:2 and 2:5), Zastawny 1:5 oblate mode 2 (used for 1:5 and 1:10).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -105,14 +108,14 @@ impl RotationFit {
     }
 }
 
-/// Which density multiplies the drag and lift ([T002] eq. 4.6 prints ρ_p; physically ρ_f).
+/// Which density multiplies the drag and lift ([T002 eq. 4.6] prints ρ_p; physically ρ_f).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DragDensity {
     /// ρ_f (physical; default).
     #[default]
     Fluid,
-    /// ρ_p (as printed in [T002] eq. 4.6, 4.25).
+    /// ρ_p (as printed in [T002 eq. 4.6, 4.25]).
     Particle,
 }
 
