@@ -10,6 +10,8 @@
 //! * [`motion`]: the equation of motion and its (linearly implicit or explicit) Euler step.
 //! * [`rigid`]: quaternion kinematics and Euler's equations of axisymmetric bodies.
 //! * [`single`]: one sphere moving vertically (the thesis's reduced 1-D system).
+//! * [`spheroid`]: drag, lift, pitching and rotational torques on oblate spheroids (ch. 3-4),
+//!   and the magnetic-buoyancy torque.
 //! * [`systems`], [`collide`]: the thin ECS systems of the particle-fluid pipeline.
 //! * [`observe`]: the separation error e_m (eq. 2.51).
 //! * [`config`]: the pipeline's configuration resource.
@@ -29,5 +31,6 @@ pub mod motion;
 pub mod observe;
 pub mod rigid;
 pub mod single;
+pub mod spheroid;
 pub mod stokes_reference;
 pub mod systems;
