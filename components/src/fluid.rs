@@ -66,10 +66,10 @@ impl InertialBody {
     ///
     /// ```
     /// use magsep_components::fluid::InertialBody;
-    /// // disc p3 of thesis 002, Table 4.1: 5 mm x 0.5 mm, V = 9.82 mm³, d_e = 2.657 mm
-    /// let b = InertialBody::spheroid(2.5e-3, 0.25e-3, 1434.0);
-    /// assert!((b.volume * 1e9 - 9.817).abs() < 1e-3);
-    /// assert!((b.diameter * 1e3 - 2.657).abs() < 1e-3);
+    /// // spheroid p1 of thesis 002, Table 4.1: 5 mm x 2.5 mm, V = 32.73 mm³, d_e = 3.969 mm
+    /// let b = InertialBody::spheroid(2.5e-3, 1.25e-3, 1434.0);
+    /// assert!((b.volume * 1e9 - 32.725).abs() < 1e-3);
+    /// assert!((b.diameter * 1e3 - 3.969).abs() < 1e-3);
     /// assert!(b.inertia.z > b.inertia.x);
     /// ```
     pub fn spheroid(a: f64, c: f64, density: f64) -> Self {

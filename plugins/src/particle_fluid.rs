@@ -6,6 +6,8 @@
 //! | [`InertialForcesPlugin`] | `Prepare` | `sample_fluid` (non-quiescent flows only) | `FluidSample` |
 //! | | `Forces::Field` | `compute_body_forces`, `compute_magnetic_buoyancy` | `GravityForce`, `BuoyancyForce`, `MagneticBuoyancyForce` |
 //! | | `Forces::Fluid` | `compute_drag`, `compute_undisturbed_flow`, `compute_history`, `compute_rotational_drag` | `DragForce`, `UndisturbedFlowForce`, `HistoryForce`, `BassetHistory`, `RotationalDragTorque` |
+//! | | `Forces::Fluid` (spheroids) | `compute_spheroid_loads`, `compute_spheroid_rotational_drag` | `DragForce`, `LiftForce`, `PitchingTorque`, `RotationalDragTorque` |
+//! | | `Forces::Field` (spheroids) | `compute_magnetic_torque` | `MagneticTorque` |
 //! | [`InertialIntegratorPlugin`] | `Mobility` | `update_velocities` | `Velocity`, `AngularVelocity`, `HistoryForce`, `Health` |
 //! | | `Integrate` | `integrate_positions` | `Position`, `Orientation`, `StepStart` |
 //! | | `FinalizeSystems::WriteBack` | `wrap_periodic` | `Position` |
@@ -32,6 +34,10 @@ use magsep_systems::fluid::config::ParticleFluidConfig;
 use magsep_systems::fluid::history::{HistoryKernel, HistoryPlan, HistoryState};
 use magsep_systems::fluid::observe::{
     SeparationCurve, observe_separation, should_observe_separation,
+};
+use magsep_systems::fluid::spheroid_systems::{
+    SpheroidFluid, compute_magnetic_torque, compute_spheroid_loads,
+    compute_spheroid_rotational_drag,
 };
 use magsep_systems::fluid::systems::*;
 use magsep_systems::forces::{Consumption, ForceUse};
@@ -127,6 +133,43 @@ impl SimPlugin for InertialForcesPlugin {
             app.schedule
                 .add_systems(compute_rotational_drag.in_set(ForceSystems::Fluid));
         }
+        let spheroids = app
+            .world
+            .query::<&SpheroidFluid>()
+            .iter(&app.world)
+            .next()
+            .is_some();
+        if spheroids {
+            spheroid_terms(app, &cfg);
+        }
+    }
+}
+
+/// The spheroid systems (thesis 002, ch. 4): shape-specific drag, lift and pitching torque,
+/// rotational resistance and the magnetic torque, for the terms that are on.
+fn spheroid_terms(app: &mut SimApp, cfg: &ParticleFluidConfig) {
+    let t = cfg.terms;
+    if t.lift {
+        app.register_force::<LiftForce>();
+    }
+    if t.pitching_torque {
+        app.register_force::<PitchingTorque>();
+    }
+    if t.drag || t.lift || t.pitching_torque {
+        app.schedule.add_systems(
+            compute_spheroid_loads
+                .after(compute_drag)
+                .in_set(ForceSystems::Fluid),
+        );
+    }
+    if t.rotation {
+        app.schedule
+            .add_systems(compute_spheroid_rotational_drag.in_set(ForceSystems::Fluid));
+    }
+    if t.magnetic_torque && cfg.magnet_torque_can_act() {
+        app.register_force::<MagneticTorque>();
+        app.schedule
+            .add_systems(compute_magnetic_torque.in_set(ForceSystems::Field));
     }
 }
 

@@ -39,6 +39,9 @@ fn world() -> SimApp {
         history: false,
         rotation: false,
         collisions: false,
+        lift: false,
+        pitching_torque: false,
+        magnetic_torque: false,
     };
     app.world.insert_resource(ParticleFluidConfig {
         dt: DT,
@@ -58,6 +61,7 @@ fn world() -> SimApp {
         integrator: Integrator::Implicit,
         levitation_tolerance: 5e-4,
         observe_every: STEPS,
+        spheroids: Default::default(),
     });
     app.world
         .insert_resource(FluidDomain(CollisionDomain::unbounded()));

@@ -39,7 +39,7 @@ use glam::DVec3;
 use magsep_systems::collision::{CollisionModel, Restitution};
 use magsep_systems::fluid::collide::CollisionHistory;
 use magsep_systems::fluid::config::{
-    ForceTerms, HistoryChoice, Integrator, ParticleFluidConfig, STANDARD_GRAVITY,
+    ForceTerms, HistoryChoice, Integrator, ParticleFluidConfig, STANDARD_GRAVITY, SpheroidOptions,
 };
 use magsep_systems::fluid::drag::DragLaw;
 use magsep_systems::fluid::flow::FlowModel;
@@ -77,6 +77,12 @@ pub struct ParticleFluidSection {
     /// Sample e_m every this many steps. Default steps / 200 (at least 1).
     #[serde(default)]
     pub observe_every: Option<u64>,
+    /// How spheroids are modelled: `spin` (`suppressed` | `free`), `drag_density` (`fluid` |
+    /// `particle`), `correlation` (`sanjeevi25` | `zastawny15` | `disc110` | `sphere`),
+    /// `rotation_fit` (`zastawny_prolate52` | `zastawny_oblate15` | `sphere`). Default: the
+    /// thesis's choices by aspect ratio, spin suppressed, ρ_f in the drag.
+    #[serde(default)]
+    pub spheroids: SpheroidOptions,
 }
 
 /// `[liquid]`: the carrier liquid and its undisturbed flow.
@@ -276,6 +282,7 @@ impl ParticleFluidScene {
             integrator: s.integrator,
             levitation_tolerance: s.levitation_tolerance.unwrap_or(0.5e-3),
             observe_every: s.observe_every.unwrap_or((steps / 200).max(1)),
+            spheroids: s.spheroids,
         }
     }
 }

@@ -8,6 +8,8 @@ use magsep_components::prelude::*;
 use magsep_systems::collision::{CollisionDomain, Plane};
 use magsep_systems::fluid::collide::CollisionWorkspace;
 use magsep_systems::fluid::config::ParticleFluidConfig;
+use magsep_systems::fluid::spheroid::SpheroidHydro;
+use magsep_systems::fluid::spheroid_systems::SpheroidFluid;
 use magsep_systems::fluid::systems::FluidDomain;
 use magsep_systems::geometry::bounding_radius;
 use magsep_systems::rng::particle_stream;
@@ -234,26 +236,50 @@ pub fn spawn_particle_fluid(
                 } => InertialBody::spheroid(equatorial_radius, polar_radius, rho_p),
                 _ => InertialBody::sphere(r, rho_p),
             };
-            world.spawn((
-                ParticleBundle {
-                    id: ParticleId(id),
-                    position: Position(x),
-                    orientation: Orientation(orientation),
-                    shape,
-                    species: Species(g as u32),
-                    rng: ParticleRng(rng),
-                    net_force: NetForce::default(),
-                    net_torque: NetTorque::default(),
-                },
-                Velocity(v0),
-                AngularVelocity::default(),
-                body,
-                cfg.flow.sample(x, 0.0),
-                Levitation {
-                    equilibrium_height: cfg.equilibrium_height(rho_p).unwrap_or(f64::NAN),
-                    last_outside: 0.0,
-                },
-            ));
+            let entity = world
+                .spawn((
+                    ParticleBundle {
+                        id: ParticleId(id),
+                        position: Position(x),
+                        orientation: Orientation(orientation),
+                        shape,
+                        species: Species(g as u32),
+                        rng: ParticleRng(rng),
+                        net_force: NetForce::default(),
+                        net_torque: NetTorque::default(),
+                    },
+                    Velocity(v0),
+                    AngularVelocity::default(),
+                    body,
+                    cfg.flow.sample(x, 0.0),
+                    Levitation {
+                        equilibrium_height: cfg.equilibrium_height(rho_p).unwrap_or(f64::NAN),
+                        last_outside: 0.0,
+                    },
+                ))
+                .id();
+            if let Shape::Spheroid {
+                equatorial_radius: a,
+                polar_radius: c,
+            } = shape
+            {
+                let opts = cfg.spheroids;
+                let mut hydro = SpheroidHydro::new(
+                    2.0 * a,
+                    c / a,
+                    cfg.liquid.density,
+                    rho_p,
+                    cfg.liquid.viscosity,
+                );
+                hydro.drag_density = opts.drag_density;
+                hydro.correlation = opts.correlation.unwrap_or(hydro.correlation);
+                hydro.rotation = opts.rotation_fit.unwrap_or(hydro.rotation);
+                world.entity_mut(entity).insert(SpheroidFluid {
+                    hydro,
+                    equatorial_radius: a,
+                    polar_radius: c,
+                });
+            }
             id += 1;
         }
     }

@@ -127,6 +127,7 @@ mod tests {
             integrator: Integrator::Implicit,
             levitation_tolerance: 5e-4,
             observe_every: 1,
+            spheroids: Default::default(),
         };
         let cubes = magnet_backdrop(&cfg, DVec3::splat(0.15));
         assert_eq!(cubes.len(), SLICES + 1); // slices and the bottom face

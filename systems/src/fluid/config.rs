@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 use super::drag::DragLaw;
 use super::flow::FlowModel;
 use super::magnet::{Liquid, MagnetModel};
+use super::rigid::SpinModel;
+use super::spheroid::{Correlation, DragDensity, RotationFit};
 
 /// Standard gravity g [m/s²].
 pub const STANDARD_GRAVITY: f64 = 9.81;
@@ -36,6 +38,12 @@ pub struct ForceTerms {
     pub rotation: bool,
     /// Hard-particle collisions (particle-particle and particle-wall).
     pub collisions: bool,
+    /// Shape-induced lift of spheroids at incidence.
+    pub lift: bool,
+    /// Pitching torque of spheroids at incidence.
+    pub pitching_torque: bool,
+    /// Magnetic-buoyancy torque on spheroids.
+    pub magnetic_torque: bool,
 }
 
 impl Default for ForceTerms {
@@ -50,6 +58,9 @@ impl Default for ForceTerms {
             history: true,
             rotation: true,
             collisions: true,
+            lift: true,
+            pitching_torque: true,
+            magnetic_torque: true,
         }
     }
 }
@@ -98,6 +109,22 @@ pub enum Integrator {
     Explicit,
 }
 
+/// How spheroids are modelled (scene key `spheroids`; every key optional).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SpheroidOptions {
+    /// Rotation about the symmetry axis: `suppressed` (the thesis; default) or `free`.
+    pub spin: SpinModel,
+    /// Density in the drag and lift: `fluid` (default) or `particle` (as the thesis prints).
+    pub drag_density: DragDensity,
+    /// Drag/lift/pitching correlation for every spheroid. Default: by aspect ratio (the
+    /// thesis's choice: Sanjeevi 2:5 for w >= 0.3, Zastawny 1:5 for w >= 0.15, else 1:10).
+    pub correlation: Option<Correlation>,
+    /// Rotational-resistance fit for every spheroid. Default: by aspect ratio (Zastawny 5:2
+    /// prolate for w >= 0.3, Zastawny 1:5 oblate below).
+    pub rotation_fit: Option<RotationFit>,
+}
+
 /// The particle-fluid pipeline's configuration.
 #[derive(Resource, Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParticleFluidConfig {
@@ -129,6 +156,9 @@ pub struct ParticleFluidConfig {
     pub levitation_tolerance: f64,
     /// Sample the separation error every this many steps.
     pub observe_every: u64,
+    /// How spheroids are modelled.
+    #[serde(default)]
+    pub spheroids: SpheroidOptions,
 }
 
 impl ParticleFluidConfig {
@@ -149,6 +179,11 @@ impl ParticleFluidConfig {
         self.terms.magnetic_buoyancy
             && !matches!(self.magnet, MagnetModel::None)
             && self.liquid.susceptibility != 0.0
+    }
+
+    /// Whether a magnetic torque can act (a magnet and a magnetisable liquid).
+    pub fn magnet_torque_can_act(&self) -> bool {
+        !matches!(self.magnet, MagnetModel::None) && self.liquid.susceptibility != 0.0
     }
 
     /// Whether the undisturbed-flow force runs (a non-quiescent flow).
@@ -173,6 +208,12 @@ impl ParticleFluidConfig {
             (t.history, "history"),
             (t.rotation, "rotation"),
             (t.collisions, "collisions"),
+            (t.lift, "lift"),
+            (t.pitching_torque, "pitching_torque"),
+            (
+                t.magnetic_torque && self.magnet_torque_can_act(),
+                "magnetic_torque",
+            ),
         ] {
             if on {
                 out.push(name);

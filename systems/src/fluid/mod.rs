@@ -12,7 +12,8 @@
 //! * [`single`]: one sphere moving vertically (the thesis's reduced 1-D system).
 //! * [`spheroid`]: drag, lift, pitching and rotational torques on oblate spheroids (ch. 3-4),
 //!   and the magnetic-buoyancy torque.
-//! * [`systems`], [`collide`]: the thin ECS systems of the particle-fluid pipeline.
+//! * [`systems`], [`spheroid_systems`], [`collide`]: the thin ECS systems of the particle-fluid
+//!   pipeline.
 //! * [`observe`]: the separation error e_m (eq. 2.51).
 //! * [`config`]: the pipeline's configuration resource.
 //! * [`history`]: the Basset history integral: full-memory product integration and the
@@ -32,5 +33,6 @@ pub mod observe;
 pub mod rigid;
 pub mod single;
 pub mod spheroid;
+pub mod spheroid_systems;
 pub mod stokes_reference;
 pub mod systems;

@@ -20,6 +20,8 @@ use super::config::{Integrator, ParticleFluidConfig};
 use super::drag::{rotational_drag, translational_drag};
 use super::history::{HistoryPlan, HistoryState, basset_coefficient};
 use super::motion::{effective_mass, rotate, velocity_step};
+use super::rigid::angular_velocity_step;
+use super::spheroid_systems::SpheroidFluid;
 use crate::collision::CollisionDomain;
 
 /// The Basset history plan shared by all particles (a resource).
@@ -101,7 +103,7 @@ pub fn compute_magnetic_buoyancy(
 pub fn compute_drag(
     cfg: Res<ParticleFluidConfig>,
     mut stats: ResMut<ParticleFluidStats>,
-    mut q: Query<(&Velocity, &FluidSample, &InertialBody, &mut DragForce)>,
+    mut q: Query<(&Velocity, &FluidSample, &InertialBody, &mut DragForce), Without<SpheroidFluid>>,
 ) {
     let (rho, mu, law) = (cfg.liquid.density, cfg.liquid.viscosity, cfg.drag_law);
     let mut re_max = stats.max_reynolds;
@@ -167,15 +169,18 @@ pub fn compute_history(
         });
 }
 
-/// Rotational drag with its stiffness (`Forces::Fluid`).
+/// Rotational drag of spheres with its stiffness (`Forces::Fluid`).
 pub fn compute_rotational_drag(
     cfg: Res<ParticleFluidConfig>,
-    mut q: Query<(
-        &AngularVelocity,
-        &FluidSample,
-        &InertialBody,
-        &mut RotationalDragTorque,
-    )>,
+    mut q: Query<
+        (
+            &AngularVelocity,
+            &FluidSample,
+            &InertialBody,
+            &mut RotationalDragTorque,
+        ),
+        Without<SpheroidFluid>,
+    >,
 ) {
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
     q.par_iter_mut().for_each(|(w, s, b, mut t)| {
@@ -186,7 +191,8 @@ pub fn compute_rotational_drag(
 }
 
 /// Advance velocities and angular velocities (`Mobility`): linearly implicit Euler with the
-/// drag, added mass and newest history weight implicit, or forward Euler. With the implicit
+/// drag, added mass and newest history weight implicit, or forward Euler; spheroids rotate by
+/// Euler's equations ([`super::rigid`]). With the implicit
 /// scheme the history force is completed with its newest-step part.
 #[allow(clippy::type_complexity)]
 pub fn update_velocities(
@@ -203,6 +209,7 @@ pub fn update_velocities(
         &mut Velocity,
         &mut AngularVelocity,
         Option<&mut HistoryForce>,
+        (&Orientation, Has<SpheroidFluid>),
     )>,
 ) {
     let dt = cfg.dt;
@@ -210,7 +217,8 @@ pub fn update_velocities(
     let history_weight = plan.as_ref().map(|p| p.0.newest_weight()).unwrap_or(0.0);
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
     let added = cfg.terms.added_mass;
-    for (id, f, t, b, drag, rot, mut v, mut w, hist) in &mut q {
+    let spin = cfg.spheroids.spin;
+    for (id, f, t, b, drag, rot, mut v, mut w, hist, (o, spheroid)) in &mut q {
         let mass = effective_mass(b.mass, b.volume, rho, added);
         let mut stiffness = 0.0;
         let mut history_stiffness = 0.0;
@@ -230,7 +238,11 @@ pub fn update_velocities(
         } else {
             0.0
         };
-        let w_new = velocity_step(w.0, t.0, b.inertia.x, k_rot, dt);
+        let w_new = if spheroid {
+            angular_velocity_step(w.0, t.0, o.0, b.inertia, k_rot, dt, spin)
+        } else {
+            velocity_step(w.0, t.0, b.inertia.x, k_rot, dt)
+        };
         if !(v_new.is_finite() && w_new.is_finite()) {
             health.report(format!(
                 "non-finite velocity of particle {} (dt too large for the explicit scheme?)",
