@@ -22,11 +22,38 @@ use crate::scene::{OrientationSpec, PlacementSpec, Scene, SpawnError};
 /// Rejection attempts per particle before a region is declared too full.
 const MAX_ATTEMPTS: usize = 100_000;
 
-/// Placed spheres on a hash grid (cell = the largest diameter), for overlap checks.
+/// The space a placed particle claims: its bounding sphere, or for a spheroid with a vertical
+/// symmetry axis (broadside) its bounding vertical cylinder (radius a, half height c), which
+/// lets flat flakes stack as densely as the thesis injects them.
+#[derive(Debug, Clone, Copy)]
+struct Claim {
+    /// Bounding-sphere radius \[m\].
+    radius: f64,
+    /// (a, c) of a broadside spheroid \[m\].
+    upright: Option<(f64, f64)>,
+}
+
+impl Claim {
+    fn overlaps(&self, other: &Claim, d: DVec3) -> bool {
+        match (self.upright, other.upright) {
+            (Some((a1, c1)), Some((a2, c2))) => {
+                d.z.abs() < c1 + c2 && d.x.hypot(d.y) < a1 + a2
+            }
+            _ => d.length() < self.radius + other.radius,
+        }
+    }
+
+    /// Horizontal and vertical half extents \[m\] (for the margins of a start region).
+    fn extents(&self) -> (f64, f64) {
+        self.upright.unwrap_or((self.radius, self.radius))
+    }
+}
+
+/// Placed particles on a hash grid (cell = the largest diameter), for overlap checks.
 struct Placed {
     cell: f64,
     grid: HashMap<[i64; 3], Vec<usize>>,
-    spheres: Vec<(DVec3, f64)>,
+    spheres: Vec<(DVec3, Claim)>,
     domain: CollisionDomain,
 }
 
@@ -36,7 +63,7 @@ impl Placed {
         [k.x as i64, k.y as i64, k.z as i64]
     }
 
-    fn clear(&self, x: DVec3, r: f64) -> bool {
+    fn clear(&self, x: DVec3, claim: Claim) -> bool {
         // periodic images are found through the minimum image of each candidate; cells of
         // the periodic faces are checked by wrapping the query point's neighbours
         for dx in -1..=1 {
@@ -47,8 +74,8 @@ impl Placed {
                         .wrap(x + DVec3::new(dx as f64, dy as f64, dz as f64) * self.cell);
                     if let Some(list) = self.grid.get(&self.key(probe)) {
                         for &j in list {
-                            let (y, s) = self.spheres[j];
-                            if self.domain.minimum_image(x - y).length() < r + s {
+                            let (y, other) = self.spheres[j];
+                            if claim.overlaps(&other, self.domain.minimum_image(x - y)) {
                                 return false;
                             }
                         }
@@ -59,10 +86,10 @@ impl Placed {
         true
     }
 
-    fn insert(&mut self, x: DVec3, r: f64) {
+    fn insert(&mut self, x: DVec3, claim: Claim) {
         let k = self.key(self.domain.wrap(x));
         self.grid.entry(k).or_default().push(self.spheres.len());
-        self.spheres.push((x, r));
+        self.spheres.push((x, claim));
     }
 }
 
@@ -156,8 +183,22 @@ pub fn spawn_particle_fluid(
     let mut id = 0u64;
     for (g, group) in scene.particles.iter().enumerate() {
         let shape = group.shape.shape();
-        // placement keeps the bounding spheres apart
         let r = bounding_radius(&shape);
+        // a fixed orientation is known before placement (a random one is drawn after it, from
+        // the particle's stream); a broadside spheroid claims its bounding cylinder
+        let spec = group.orientation.unwrap_or_default();
+        let upright = match (shape, spec) {
+            (
+                Shape::Spheroid {
+                    equatorial_radius,
+                    polar_radius,
+                },
+                OrientationSpec::Broadside,
+            ) => Some((equatorial_radius, polar_radius)),
+            _ => None,
+        };
+        let claim = Claim { radius: r, upright };
+        let (rh, rv) = claim.extents();
         let Some(placement) = &group.placement else {
             continue;
         };
@@ -200,8 +241,8 @@ pub fn spawn_particle_fluid(
                     let wrong = (seen as f64) < (impurity * total as f64).round();
                     let band = if heavy_kind != wrong { heavy } else { light };
                     (
-                        DVec3::new(r, r, band[0].max(r)),
-                        DVec3::new(edges.x - r, edges.y - r, band[1].min(edges.z - r)),
+                        DVec3::new(rh, rh, band[0].max(rv)),
+                        DVec3::new(edges.x - rh, edges.y - rh, band[1].min(edges.z - rv)),
                         false,
                     )
                 }
@@ -215,7 +256,7 @@ pub fn spawn_particle_fluid(
             for _ in 0..MAX_ATTEMPTS {
                 let u = DVec3::new(rng.random(), rng.random(), rng.random());
                 let x = lo + (hi - lo) * u;
-                if explicit || placed.clear(x, r) {
+                if explicit || placed.clear(x, claim) {
                     found = Some(x);
                     break;
                 }
@@ -226,9 +267,9 @@ pub fn spawn_particle_fluid(
                      attempts (start region too small for count = {n})"
                 )));
             };
-            placed.insert(x, r);
+            placed.insert(x, claim);
             let v0 = DVec3::from_array(group.velocity.unwrap_or([0.0; 3]));
-            let orientation = initial_orientation(group.orientation.unwrap_or_default(), &mut rng);
+            let orientation = initial_orientation(spec, &mut rng);
             let body = match shape {
                 Shape::Spheroid {
                     equatorial_radius,
