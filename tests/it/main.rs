@@ -24,3 +24,4 @@ mod pipeline_framework;
 mod scene_fuzz;
 mod schedule;
 mod signals;
+mod spheroids;
