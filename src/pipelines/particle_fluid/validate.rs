@@ -252,6 +252,10 @@ fn validate_group(
             return;
         }
     };
+    if !radius.is_finite() {
+        // the shape's own error is reported; nothing else can be checked against it
+        return;
+    }
     if let Some(o) = g.orientation {
         let ok = match o {
             OrientationSpec::Axis(v) => {
