@@ -57,7 +57,10 @@ fn v2_levitation_time_grows_as_the_flake_gets_flatter() {
     assert!((t[0] - 7.5).abs() < 0.3, "sphere {}", t[0]);
     for (k, want) in [(1, 0.14), (2, 0.23), (3, 0.44)] {
         let rise = t[k] / t[0] - 1.0;
-        assert!((rise - want).abs() < 0.04, "w index {k}: +{rise:.3}, want +{want}");
+        assert!(
+            (rise - want).abs() < 0.04,
+            "w index {k}: +{rise:.3}, want +{want}"
+        );
     }
     // every one at the point-formula equilibrium, y_e = -0.344 L (z = 49.2 mm)
     for p in details(&summary) {
@@ -98,10 +101,16 @@ fn v1_table_4_1_particles_reach_equilibrium_and_the_spheroid_is_fastest() {
 /// The disc scene with extra `[particle_fluid]` lines, an orientation and a duration.
 fn disc(orientation: &str, duration: f64, z0: f64, extra: &str) -> String {
     shipped("flake_disc.toml")
-        .replace("orientation = \"broadside\"", &format!("orientation = {orientation}"))
+        .replace(
+            "orientation = \"broadside\"",
+            &format!("orientation = {orientation}"),
+        )
         .replace("duration = 25.0 ", &format!("duration = {duration} "))
         .replace("0.075, 0.075, 0.1042", &format!("0.075, 0.075, {z0}"))
-        .replace("observe_every = 25", &format!("observe_every = 25\n{extra}"))
+        .replace(
+            "observe_every = 25",
+            &format!("observe_every = 25\n{extra}"),
+        )
 }
 
 #[test]
@@ -153,7 +162,10 @@ fn the_magnetic_torque_lays_a_flake_flat_at_equilibrium() {
 fn many(w: f64, fraction: f64, duration: f64) -> String {
     shipped("flakes_case4.toml")
         .replace("aspect_ratio = 0.5", &format!("aspect_ratio = {w}"))
-        .replace("volume_fraction = 0.01 ", &format!("volume_fraction = {fraction} "))
+        .replace(
+            "volume_fraction = 0.01 ",
+            &format!("volume_fraction = {fraction} "),
+        )
         .replace("duration = 6.0 ", &format!("duration = {duration} "))
 }
 
@@ -186,5 +198,8 @@ fn v6_separation_error_at_three_seconds_full_size() {
     assert!(e[0] < e[1] && e[1] < e[2], "{e:?}");
     assert!((e[0] - 0.006).abs() < 0.3 * 0.006, "spheres {e:?}");
     assert!((e[1] - 0.0118).abs() < 0.1 * 0.0118, "1:2 regression {e:?}");
-    assert!((e[2] - 0.0236).abs() < 0.1 * 0.0236, "1:10 regression {e:?}");
+    assert!(
+        (e[2] - 0.0236).abs() < 0.1 * 0.0236,
+        "1:10 regression {e:?}"
+    );
 }

@@ -36,9 +36,7 @@ struct Claim {
 impl Claim {
     fn overlaps(&self, other: &Claim, d: DVec3) -> bool {
         match (self.upright, other.upright) {
-            (Some((a1, c1)), Some((a2, c2))) => {
-                d.z.abs() < c1 + c2 && d.x.hypot(d.y) < a1 + a2
-            }
+            (Some((a1, c1)), Some((a2, c2))) => d.z.abs() < c1 + c2 && d.x.hypot(d.y) < a1 + a2,
             _ => d.length() < self.radius + other.radius,
         }
     }

@@ -6,16 +6,19 @@
 //! * `magsep chart history`: [`chart_history`].
 //! * `magsep chart collisions`: [`chart_collisions`].
 //! * `magsep chart separation`: [`chart_separation`].
+//! * `magsep chart flakes`: [`chart_flakes`] (spheroids, ch. 4).
 //! * `magsep bench particle-fluid`: [`bench_particle_fluid`].
 
 mod bench;
 mod collisions;
+mod flakes;
 mod history;
 mod levitation;
 mod separation;
 
 pub use bench::bench_particle_fluid;
 pub use collisions::chart_collisions;
+pub use flakes::chart_flakes;
 pub use history::chart_history;
 pub use levitation::chart_levitation;
 pub use separation::chart_separation;

@@ -233,8 +233,15 @@ fn thin_disc_rotation_explicit_fails_beyond_two_relaxation_times_implicit_does_n
         for _ in 0..200 {
             let (torque, k) = rotational_resistance(&hydro, -omega);
             let stiffness = if implicit { k } else { 0.0 };
-            let next =
-                angular_velocity_step(omega, torque, q, body.inertia, stiffness, dt, SpinModel::Suppressed);
+            let next = angular_velocity_step(
+                omega,
+                torque,
+                q,
+                body.inertia,
+                stiffness,
+                dt,
+                SpinModel::Suppressed,
+            );
             if implicit {
                 assert!(next.length() <= omega.length() && next.dot(omega) >= 0.0);
             }
@@ -248,7 +255,10 @@ fn thin_disc_rotation_explicit_fails_beyond_two_relaxation_times_implicit_does_n
     };
     // below the limit both decay; above it the explicit update overshoots and grows
     assert!(run(0.5 * tau, false) <= 100.0 + 1e-9);
-    assert!(run(4.0 * tau, false) > 100.0, "explicit should fail at 4 τ_r");
+    assert!(
+        run(4.0 * tau, false) > 100.0,
+        "explicit should fail at 4 τ_r"
+    );
     for dt in [0.5 * tau, 4.0 * tau, 100.0 * tau] {
         assert!(run(dt, true) <= 100.0 + 1e-9);
     }
