@@ -234,6 +234,8 @@ pub enum ChartKind {
     Collisions,
     /// Many-particle density separation.
     Separation,
+    /// Models of the 1:10 spheroid's drag, lift and torque: error against cost.
+    SpheroidModel,
 }
 
 /// `magsep bench KIND [--json] [--quick]`.
@@ -352,6 +354,7 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         ChartKind::History => return fc::chart_history(out, quick),
         ChartKind::Collisions => return fc::chart_collisions(out, quick),
         ChartKind::Separation => return fc::chart_separation(out, quick),
+        ChartKind::SpheroidModel => return fc::chart_spheroid_model(out, quick),
         ChartKind::SqContact => {
             std::fs::create_dir_all(out)
                 .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;

@@ -6,6 +6,8 @@
 //! * `magsep chart history`: [`chart_history`].
 //! * `magsep chart collisions`: [`chart_collisions`].
 //! * `magsep chart separation`: [`chart_separation`].
+//! * `magsep chart spheroid-model`: [`chart_spheroid_model`] (thesis 002, ch. 3-4: models of
+//!   the 1:10 spheroid's coefficients, error against cost).
 //! * `magsep bench particle-fluid`: [`bench_particle_fluid`].
 
 mod bench;
@@ -13,12 +15,14 @@ mod collisions;
 mod history;
 mod levitation;
 mod separation;
+mod spheroid_model;
 
 pub use bench::bench_particle_fluid;
 pub use collisions::chart_collisions;
 pub use history::chart_history;
 pub use levitation::chart_levitation;
 pub use separation::chart_separation;
+pub use spheroid_model::chart_spheroid_model;
 
 use crate::scene::parse_scene;
 use crate::sim::{RunOptions, Simulation};

@@ -354,55 +354,68 @@ impl DiscModel {
         self.method
     }
 
-    /// The raw interpolated quantity q (0: C_D Re_e, 1: C_L Re_e, 2: C_T) at (x, y), with x and
-    /// y inside the fitted grid.
-    fn surface(&self, q: usize, x: f64, y: f64) -> f64 {
+    /// The raw interpolated quantities (C_D Re_e, C_L Re_e, C_T, or C per [`Variant`]) at
+    /// (x, y) inside the fitted grid; the cell and basis are found once for all three.
+    fn surfaces_at(&self, x: f64, y: f64) -> [f64; 3] {
         let (nx, ny) = (self.xs.len(), self.ys.len());
-        match &self.surfaces[q] {
-            Surface::Ls(coef) => {
-                let (Some(&x0), Some(&x1)) = (self.xs.first(), self.xs.last()) else {
+        if nx < 2 || ny < 2 {
+            return [0.0; 3];
+        }
+        if self.method == DiscMethod::LeastSquares {
+            let (x0, x1) = (self.xs[0], self.xs[nx - 1]);
+            let mut basis = [0.0; LS_NX * LS_NY];
+            return [0, 1, 2].map(|q| {
+                let Surface::Ls(coef) = &self.surfaces[q] else {
                     return 0.0;
                 };
-                let mut basis = [0.0; LS_NX * LS_NY];
                 Self::ls_basis(q, x, y, x0, x1, &mut basis);
                 basis.iter().zip(coef).map(|(a, b)| a * b).sum()
-            }
-            Surface::Grid { f, fx, fy, fxy } => {
-                if nx < 2 || ny < 2 {
-                    return 0.0;
-                }
-                let c = self.xs.partition_point(|&v| v <= x).clamp(1, nx - 1) - 1;
-                let r = self.ys.partition_point(|&v| v <= y).clamp(1, ny - 1) - 1;
-                let (hx, hy) = (self.xs[c + 1] - self.xs[c], self.ys[r + 1] - self.ys[r]);
-                let (t, u) = ((x - self.xs[c]) / hx, (y - self.ys[r]) / hy);
-                let idx = |rr: usize, cc: usize| rr * nx + cc;
-                if self.method == DiscMethod::Bilinear {
-                    return (1.0 - u) * ((1.0 - t) * f[idx(r, c)] + t * f[idx(r, c + 1)])
-                        + u * ((1.0 - t) * f[idx(r + 1, c)] + t * f[idx(r + 1, c + 1)]);
-                }
-                let h = |s: f64| {
-                    let (s2, s3) = (s * s, s * s * s);
-                    [
-                        2.0 * s3 - 3.0 * s2 + 1.0,
-                        s3 - 2.0 * s2 + s,
-                        -2.0 * s3 + 3.0 * s2,
-                        s3 - s2,
-                    ]
-                };
-                let (bx, by) = (h(t), h(u));
-                let mut v = 0.0;
-                for (dr, (pv, dv)) in [(0, (by[0], by[1])), (1, (by[2], by[3]))] {
-                    for (dc, (pu, du)) in [(0, (bx[0], bx[1])), (1, (bx[2], bx[3]))] {
-                        let k = idx(r + dr, c + dc);
-                        v += pv * pu * f[k]
-                            + pv * du * hx * fx[k]
-                            + dv * pu * hy * fy[k]
-                            + dv * du * hx * hy * fxy[k];
-                    }
-                }
-                v
-            }
+            });
         }
+        let c = self.xs.partition_point(|&v| v <= x).clamp(1, nx - 1) - 1;
+        let r = self.ys.partition_point(|&v| v <= y).clamp(1, ny - 1) - 1;
+        let (hx, hy) = (self.xs[c + 1] - self.xs[c], self.ys[r + 1] - self.ys[r]);
+        let (t, u) = ((x - self.xs[c]) / hx, (y - self.ys[r]) / hy);
+        let corners = [
+            r * nx + c,
+            r * nx + c + 1,
+            (r + 1) * nx + c,
+            (r + 1) * nx + c + 1,
+        ];
+        if self.method == DiscMethod::Bilinear {
+            let w = [(1.0 - u) * (1.0 - t), (1.0 - u) * t, u * (1.0 - t), u * t];
+            return [0, 1, 2].map(|q| match &self.surfaces[q] {
+                Surface::Grid { f, .. } => corners.iter().zip(w).map(|(&k, w)| w * f[k]).sum(),
+                Surface::Ls(_) => 0.0,
+            });
+        }
+        // cubic Hermite basis: value and slope weights at the two ends
+        let h = |s: f64| {
+            let (s2, s3) = (s * s, s * s * s);
+            [
+                2.0 * s3 - 3.0 * s2 + 1.0,
+                s3 - 2.0 * s2 + s,
+                -2.0 * s3 + 3.0 * s2,
+                s3 - s2,
+            ]
+        };
+        let (bx, by) = (h(t), h(u));
+        // per corner: weights of f, fx, fy, fxy
+        let mut w = [[0.0; 4]; 4];
+        for (k, wk) in w.iter_mut().enumerate() {
+            let (dr, dc) = (k / 2, k % 2);
+            let (pv, dv) = (by[2 * dr], by[2 * dr + 1]);
+            let (pu, du) = (bx[2 * dc], bx[2 * dc + 1]);
+            *wk = [pv * pu, pv * du * hx, dv * pu * hy, dv * du * hx * hy];
+        }
+        [0, 1, 2].map(|q| match &self.surfaces[q] {
+            Surface::Grid { f, fx, fy, fxy } => corners
+                .iter()
+                .zip(&w)
+                .map(|(&k, wk)| wk[0] * f[k] + wk[1] * fx[k] + wk[2] * fy[k] + wk[3] * fxy[k])
+                .sum(),
+            Surface::Ls(_) => 0.0,
+        })
     }
 
     /// `(C_D Re_e, C_L Re_e, C_T)` at any Re_e >= 0 and φ \[rad\], continued outside the
@@ -416,9 +429,13 @@ impl DiscModel {
         let x = (rc + self.variant.x_shift).ln();
         let y = phi.clamp(0.0, std::f64::consts::FRAC_PI_2);
         // the coefficients C at the clamped Re_e
+        let raw = self.surfaces_at(x, y);
         let [d, l, t] = [0, 1, 2].map(|q| {
-            let v = self.surface(q, x, y);
-            if self.variant.times_re[q] { v / rc } else { v }
+            if self.variant.times_re[q] {
+                raw[q] / rc
+            } else {
+                raw[q]
+            }
         });
         // below the table C·Re_e is held (Stokes), above it C is frozen
         let re = if re_e < re0 { re0 } else { re_e };

@@ -128,6 +128,7 @@ pub enum DragDensity {
 /// assert!((h.equivalent_diameter - 8.6e-3 * 0.1f64.cbrt()).abs() < 1e-15);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SpheroidHydro {
     /// Drag, lift and pitching-torque correlation.
     pub correlation: Correlation,
@@ -143,7 +144,8 @@ pub struct SpheroidHydro {
     pub particle_density: f64,
     /// Dynamic viscosity μ [Pa s].
     pub viscosity: f64,
-    /// Density in the drag and lift.
+    /// Density in the drag and lift (default ρ_f).
+    #[serde(default)]
     pub drag_density: DragDensity,
 }
 
