@@ -35,7 +35,9 @@
 //! per-direction end conditions above are not offered by the small interpolation crates.
 //! [`DiscMethod::Bilinear`] and [`DiscMethod::LeastSquares`] (Chebyshev polynomials of degree
 //! 5 in x times four Fourier modes in φ, 24 coefficients per quantity) are the alternatives
-//! compared by `magsep chart spheroid-model`.
+//! compared by `magsep chart spheroid-model` (one Re column held out, mean errors drag / lift /
+//! torque: bilinear 1.4 / 4.0 / 0.44 % at ≈ 50 ns per evaluation of all three, spline
+//! 0.14 / 0.45 / 0.28 % at ≈ 85 ns, least squares 0.44 / 2.4 / 0.59 % at ≈ 250 ns).
 
 use super::correlations::Coefficients;
 use super::disc_table::{DRAG, LIFT, PHI_DEG, TORQUE, re_e};
