@@ -81,6 +81,7 @@ pub fn chart_spheroid_model(out: &Path, quick: bool) -> Result<(), BenchError> {
     let mut rows = Vec::new();
     let log_re = Variant {
         x_shift: 0.0,
+        x_power: 0.0,
         ..Variant::default()
     };
     for (name, method, variant) in [

@@ -76,6 +76,19 @@ pub struct Variant {
     pub times_re: [bool; 3],
     /// Shift of the abscissa.
     pub x_shift: f64,
+    /// If > 0, the abscissa is `Re_e^x_power` instead of the logarithm.
+    pub x_power: f64,
+}
+
+impl Variant {
+    /// The abscissa of Re_e.
+    pub fn abscissa(&self, re: f64) -> f64 {
+        if self.x_power > 0.0 {
+            re.powf(self.x_power)
+        } else {
+            (re + self.x_shift).ln()
+        }
+    }
 }
 
 impl Default for Variant {
@@ -83,6 +96,7 @@ impl Default for Variant {
         Self {
             times_re: TIMES_RE,
             x_shift: X_SHIFT,
+            x_power: 0.0,
         }
     }
 }
@@ -250,10 +264,7 @@ impl DiscModel {
     ) -> Self {
         let cols: Vec<usize> = cols.iter().copied().filter(|&j| j < NX).collect();
         let rows: Vec<usize> = rows.iter().copied().filter(|&i| i < NY).collect();
-        let xs: Vec<f64> = cols
-            .iter()
-            .map(|&j| (re_e(j) + variant.x_shift).ln())
-            .collect();
+        let xs: Vec<f64> = cols.iter().map(|&j| variant.abscissa(re_e(j))).collect();
         let re_range = match (cols.first(), cols.last()) {
             (Some(&a), Some(&b)) => (re_e(a), re_e(b)),
             _ => (f64::NAN, f64::NAN),
@@ -428,7 +439,7 @@ impl DiscModel {
             return (0.0, 0.0, 0.0);
         }
         let rc = re_e.clamp(re0, re1);
-        let x = (rc + self.variant.x_shift).ln();
+        let x = self.variant.abscissa(rc);
         let y = phi.clamp(0.0, std::f64::consts::FRAC_PI_2);
         // the coefficients C at the clamped Re_e
         let raw = self.surfaces_at(x, y);

@@ -171,6 +171,20 @@ impl SpheroidHydro {
         }
     }
 
+    /// Semi-axes (a, c) \[m\]: a = d_major/2, c = a w with w = (d_e/d_major)³ (for
+    /// [`magnetic_torque`]).
+    ///
+    /// ```
+    /// use magsep_systems::fluid::spheroid::SpheroidHydro;
+    /// let (a, c) = SpheroidHydro::new(8e-3, 0.1, 1400.0, 1450.0, 5.54e-3).semi_axes();
+    /// assert!((a - 4e-3).abs() < 1e-15 && (c - 4e-4).abs() < 1e-15);
+    /// ```
+    pub fn semi_axes(&self) -> (f64, f64) {
+        let a = 0.5 * self.major_diameter;
+        let w = (self.equivalent_diameter / self.major_diameter).powi(3);
+        (a, a * w)
+    }
+
     /// The density multiplying drag and lift.
     pub fn force_density(&self) -> f64 {
         match self.drag_density {
