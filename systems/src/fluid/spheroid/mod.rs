@@ -172,7 +172,7 @@ impl SpheroidHydro {
     }
 
     /// Semi-axes (a, c) \[m\]: a = d_major/2, c = a w with w = (d_e/d_major)³ (for
-    /// [`magnetic_torque`]).
+    /// [`magnetic_torque()`]).
     ///
     /// ```
     /// use magsep_systems::fluid::spheroid::SpheroidHydro;
