@@ -1,43 +1,42 @@
 //! Models of the 1:10 database ([`super::disc_table`], [T002 Tables 3.3-3.5]) in place of the
-//! thesis's neural network (3 × 300 ReLU, trained on 236 of the 266 points; its weights are
-//! not published, [T002 §3.4]).
+//! thesis's neural network (3 × 300 ReLU, trained on 236 of the 266 points; its weights are not
+//! published, [T002 §3.4]).
 //!
-//! The run-time model (D-002-12; [`DiscMethod::Spline`], [`disc_coefficients`]) is the tensor-product
-//! cubic spline in `(x, φ) = (ln(1 + Re_e), φ)` through all 266 nodes, stored as bicubic
-//! Hermite patches whose node derivatives come from 1-D splines (so it interpolates every node
-//! exactly and is C² in each variable). Interpolated quantities: `C_D Re_e`, `C_L Re_e` and
-//! `C_T`, the forms that tend to constants in the Stokes limit (C_D Re_e grows only from 35 to
-//! 108 over the table at 0°, while C_D varies 40-fold). The abscissa ln(1 + Re_e) is ≈ Re_e
-//! in the Stokes-Oseen range, where `C Re_e ≈ A + B Re_e`, and ≈ ln Re_e above; it was chosen
-//! over ln Re_e and over C_L, C_T Re_e by the held-out errors (leave one Re column out: max
-//! 0.65 / 2.6 / 1.9 % for drag / lift / torque against 0.73 / 3.4 / 2.5 % with ln Re_e).
-//! End conditions: natural in x; in φ, zero slope for drag (even about 0° and 90°) and
-//! natural for lift and torque (odd about 0° and 90°, where they vanish: a natural spline is
-//! exactly the odd continuation). Lift and torque nodes at φ = 0° and 90° (printed 0.01-0.08,
-//! noise) are set to 0.
+//! The run-time model (D-002-12; [`DiscMethod::Spline`], [`disc_coefficients`]) is the
+//! tensor-product cubic spline in `(x, φ) = (ln(1 + Re_e), φ)` through all 266 nodes, stored as
+//! bicubic Hermite patches whose node derivatives come from 1-D splines (so it interpolates every
+//! node exactly and is C² in each variable). Interpolated quantities: `C_D Re_e`, `C_L Re_e` and
+//! `C_T`, the forms that tend to constants in the Stokes limit (C_D Re_e grows only from 35 to 108
+//! over the table at 0°, while C_D varies 40-fold). The abscissa ln(1 + Re_e) is ≈ Re_e in the
+//! Stokes-Oseen range, where `C Re_e ≈ A + B Re_e`, and ≈ ln Re_e above; it was chosen over ln Re_e
+//! and over C_L, C_T Re_e by the held-out errors (leave one Re column out: max 0.65 / 2.6 / 1.9 %
+//! for drag / lift / torque against 0.73 / 3.4 / 2.5 % with ln Re_e). End conditions: natural in x;
+//! in φ, zero slope for drag (even about 0° and 90°) and natural for lift and torque (odd about 0°
+//! and 90°, where they vanish: a natural spline is exactly the odd continuation). Lift and torque
+//! nodes at φ = 0° and 90° (printed 0.01-0.08, noise) are set to 0.
 //!
-//! Held-out accuracy ([`super::disc_validation`], refits without the held-out nodes): leaving out one Re
-//! column at a time, mean errors 0.14 / 0.45 / 0.28 %; leaving out one angle row at a time,
-//! 0.08 / 0.35 / 0.49 % with maxima of 1.4 / 12 / 16 % at the 85° row and Re_e = 55.7, where
-//! lift and torque drop steeply to 0 at 90° (a feature no interpolant can recover from the
-//! 80° and 90° rows alone). The thesis's network: mean 1.5 % (drag), < 3 % (lift, torque) on
-//! 30 random held-out points.
+//! Held-out accuracy ([`super::disc_validation`], refits without the held-out nodes): leaving out
+//! one Re column at a time, mean errors 0.14 / 0.45 / 0.28 %; leaving out one angle row at a time,
+//! 0.08 / 0.35 / 0.49 % with maxima of 1.4 / 12 / 16 % at the 85° row and Re_e = 55.7, where lift
+//! and torque drop steeply to 0 at 90° (a feature no interpolant can recover from the 80° and 90°
+//! rows alone). The thesis's network: mean 1.5 % (drag), < 3 % (lift, torque) on 30 random held-out
+//! points.
 //!
-//! Outside the table (D-002-11): below Re_e = 0.464 drag and lift follow Stokes scaling (C·Re_e held,
-//! force ∝ |u − v|) and the torque coefficient is held (torque ∝ |u − v|², a fore-aft
-//! symmetric body has no Stokes torque, erratum E-002-18). Deviation: a constant lift coefficient (lift ∝
-//! |u − v|²) would be inconsistent with the table itself, whose 0.464 column already has the
-//! Stokes ratio C_L/C_D = (C_D90 − C_D0)/(C_D90 + C_D0) at 45° (0.196 against 0.185). Above
-//! Re_e = 55.7 (the steady-wake limit Re ≈ 120-130 of the database) the coefficients are
-//! frozen at the last column. φ is clamped to [0, π/2].
+//! Outside the table (D-002-11): below Re_e = 0.464 drag and lift follow Stokes scaling (C·Re_e
+//! held, force ∝ |u − v|) and the torque coefficient is held (torque ∝ |u − v|², a fore-aft
+//! symmetric body has no Stokes torque, erratum E-002-18). Deviation: a constant lift coefficient
+//! (lift ∝ |u − v|²) would be inconsistent with the table itself, whose 0.464 column already has
+//! the Stokes ratio C_L/C_D = (C_D90 − C_D0)/(C_D90 + C_D0) at 45° (0.196 against 0.185). Above
+//! Re_e = 55.7 (the steady-wake limit Re ≈ 120-130 of the database) the coefficients are frozen at
+//! the last column. φ is clamped to [0, π/2].
 //!
 //! The spline is hand-written: 14 × 19 nodes need a 60-line tridiagonal solver, and the
 //! per-direction end conditions above are not offered by the small interpolation crates.
-//! [`DiscMethod::Bilinear`] and [`DiscMethod::LeastSquares`] (Chebyshev polynomials of degree
-//! 5 in x times four Fourier modes in φ, 24 coefficients per quantity) are the alternatives
-//! compared by `magsep chart spheroid-model` (one Re column held out, mean errors drag / lift /
-//! torque: bilinear 1.4 / 4.0 / 0.44 % at ≈ 50 ns per evaluation of all three, spline
-//! 0.14 / 0.45 / 0.28 % at ≈ 85 ns, least squares 0.44 / 2.4 / 0.59 % at ≈ 250 ns).
+//! [`DiscMethod::Bilinear`] and [`DiscMethod::LeastSquares`] (Chebyshev polynomials of degree 5 in
+//! x times four Fourier modes in φ, 24 coefficients per quantity) are the alternatives compared by
+//! `magsep chart spheroid-model` (one Re column held out, mean errors drag / lift / torque:
+//! bilinear 1.4 / 4.0 / 0.44 % at ≈ 50 ns per evaluation of all three, spline 0.14 / 0.45 / 0.28 %
+//! at ≈ 85 ns, least squares 0.44 / 2.4 / 0.59 % at ≈ 250 ns).
 
 use super::correlations::Coefficients;
 use super::disc_table::{DRAG, LIFT, PHI_DEG, TORQUE, re_e};
