@@ -236,6 +236,8 @@ pub enum ChartKind {
     Separation,
     /// Flat particles (spheroids): levitation, orientation, force budget, separation.
     Flakes,
+    /// Models of the 1:10 spheroid's drag, lift and torque: error against cost.
+    SpheroidModel,
 }
 
 /// `magsep bench KIND [--json] [--quick]`.
@@ -355,6 +357,7 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         ChartKind::Collisions => return fc::chart_collisions(out, quick),
         ChartKind::Separation => return fc::chart_separation(out, quick),
         ChartKind::Flakes => return fc::chart_flakes(out, quick),
+        ChartKind::SpheroidModel => return fc::chart_spheroid_model(out, quick),
         ChartKind::SqContact => {
             std::fs::create_dir_all(out)
                 .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;

@@ -1,4 +1,5 @@
-//! Smoke tests of `magsep chart levitation`, `history`, `separation`, `collisions` and `magsep bench
+//! Smoke tests of `magsep chart levitation`, `history`, `separation`, `collisions`,
+//! `spheroid-model` and `magsep bench
 //! particle-fluid` in their quick versions: they run, write non-empty SVGs into a fresh
 //! directory, and return Ok. Physics numbers are tested in the kernels' own tests; timings are
 //! never asserted.
@@ -62,6 +63,14 @@ fn quick_history_chart_writes_its_svgs() {
         let row: serde_json::Value = serde_json::from_str(line).unwrap();
         assert!(row["seconds_per_step"].as_f64().is_some(), "{row}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn quick_spheroid_model_chart_writes_its_svg() {
+    let dir = temp_dir("spheroid_model");
+    magsep::studies::fluid_charts::chart_spheroid_model(&dir, true).unwrap();
+    assert_svgs(&dir, &["spheroid_model.svg"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -7,6 +7,8 @@
 //! * `magsep chart collisions`: [`chart_collisions`].
 //! * `magsep chart separation`: [`chart_separation`].
 //! * `magsep chart flakes`: [`chart_flakes`] (spheroids, ch. 4).
+//! * `magsep chart spheroid-model`: [`chart_spheroid_model`] (thesis 002, ch. 3-4: models of
+//!   the 1:10 spheroid's coefficients, error against cost).
 //! * `magsep bench particle-fluid`: [`bench_particle_fluid`].
 
 mod bench;
@@ -15,6 +17,7 @@ mod flakes;
 mod history;
 mod levitation;
 mod separation;
+mod spheroid_model;
 
 pub use bench::bench_particle_fluid;
 pub use collisions::chart_collisions;
@@ -22,6 +25,7 @@ pub use flakes::chart_flakes;
 pub use history::chart_history;
 pub use levitation::chart_levitation;
 pub use separation::chart_separation;
+pub use spheroid_model::chart_spheroid_model;
 
 use crate::scene::parse_scene;
 use crate::sim::{RunOptions, Simulation};

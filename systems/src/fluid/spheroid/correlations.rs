@@ -2,44 +2,43 @@
 //! ([T002 App. 4.A], Table 4.4; \[Sanjeevi2018\]; \[Zastawny2012\]).
 //!
 //! All coefficients use the volume-equivalent sphere: `Re = ρ_f |u − v| d_e / μ`, reference area
-//! `π d_e²/4`, torque reference length d_e (the normalisation of the original papers; the
-//! Stokes limits confirm it, D-002-10). φ is the incidence: 0 edge-on, 90° broadside.
+//! `π d_e²/4`, torque reference length d_e (the normalisation of the original papers; the Stokes
+//! limits confirm it, D-002-10). φ is the incidence: 0 edge-on, 90° broadside.
 //!
 //! Sanjeevi et al. 2:5 oblate (used for w = 0.5 and 0.4), [T002 eq. 4.28-4.32]:
 //!
 //! * `C_D = C_D0 + (C_D90 − C_D0) sin²φ`,
 //!   `C_D0 = (a1/Re + a2/Re^a3) e^{−a4 Re} + a5 (1 − e^{−a4 Re})`,
-//!   `C_D90 = (a6/Re + a7/Re^a8) e^{−a9 Re} + a10 (1 − e^{−a9 Re})`.
-//!   Erratum E-002-22b: Table 4.4 labels the last drag entry "a9 = 1.469"; it is a10.
-//! * `C_L = (b1/Re + b2/Re^b3 + b4/Re^b5) sin φ^{1 + b6 Re^b7} cos φ^{1 + b8 Re^b9}`.
-//!   Erratum E-002-22a: eq. 4.31 prints `b2/Re^b2` and `b5 Re^b7`, leaving b3 and b6 unused; the form
-//!   above uses each of b1..b9 once.
-//! * `C_T = (c1/Re^c2 + c3/Re^c4) sin φ^{1 + c5 Re^c6} cos φ^{1 + c7 Re^c8}`.
-//!   Erratum E-002-22a: eq. 4.32 prints the sine exponent as `1 + c5 Re^c5`.
+//!   `C_D90 = (a6/Re + a7/Re^a8) e^{−a9 Re} + a10 (1 − e^{−a9 Re})`. Erratum E-002-22b: Table 4.4
+//!   labels the last drag entry "a9 = 1.469"; it is a10.
+//! * `C_L = (b1/Re + b2/Re^b3 + b4/Re^b5) sin φ^{1 + b6 Re^b7} cos φ^{1 + b8 Re^b9}`. Erratum
+//!   E-002-22a: eq. 4.31 prints `b2/Re^b2` and `b5 Re^b7`, leaving b3 and b6 unused; the form above
+//!   uses each of b1..b9 once.
+//! * `C_T = (c1/Re^c2 + c3/Re^c4) sin φ^{1 + c5 Re^c6} cos φ^{1 + c7 Re^c8}`. Erratum E-002-22a:
+//!   eq. 4.32 prints the sine exponent as `1 + c5 Re^c5`.
 //!
 //! Zastawny et al. 1:5 oblate (used for w = 0.2), [T002 eq. 4.33-4.37]:
 //!
 //! * `C_D = C_D0 + (C_D90 − C_D0) sin^{a0} φ`, `C_D0 = a1/Re^a2 + a3/Re^a4`,
-//!   `C_D90 = a5/Re^a6 + a7/Re^a8`. Erratum E-002-22a: eq. 4.34
-//!   prints `a1/Re^a1`.
-//! * `C_L = (b1/Re^b2 + b3/Re^b4) sin φ^{b5 + b6 Re^b7} cos φ^{b8 + b9 Re^b10}`.
-//!   Erratum E-002-22a: eq. 4.36 copies the 9-coefficient Sanjeevi lift onto a 10-coefficient set; the
-//!   form above has the structure of eq. 4.37 and uses b1..b10 once.
+//!   `C_D90 = a5/Re^a6 + a7/Re^a8`. Erratum E-002-22a: eq. 4.34 prints `a1/Re^a1`.
+//! * `C_L = (b1/Re^b2 + b3/Re^b4) sin φ^{b5 + b6 Re^b7} cos φ^{b8 + b9 Re^b10}`. Erratum E-002-22a:
+//!   eq. 4.36 copies the 9-coefficient Sanjeevi lift onto a 10-coefficient set; the form above has
+//!   the structure of eq. 4.37 and uses b1..b10 once.
 //! * `C_T = (c1/Re^c2 + c3/Re^c4) sin φ^{c5 + c6 Re^c7} cos φ^{c8 + c9 Re^c10}` (eq. 4.37).
 //!
 //! Rotational resistance, Zastawny mode 2 (rotation about an equatorial axis), eq. 4.38:
 //! `C_R = r1 Re_r^r2 + r3 / Re_r^r4`, `Re_r = ρ_f d_e² |½ω − Ω| / μ` ([T002 §4.2] refers to a
 //! definition it does not give, erratum E-002-29; this is the sphere's, eq. 2.31, with d_e), and
-//! `T_R = (1/64) ρ_f C_R |½ω − Ω| (½ω − Ω) d_e⁵` (ρ_f: eq. 4.9 prints a bare ρ). The 5:2
-//! prolate fit is the thesis's stand-in for 1:2 spheroids, the 1:5 oblate fit for 1:10.
+//! `T_R = (1/64) ρ_f C_R |½ω − Ω| (½ω − Ω) d_e⁵` (ρ_f: eq. 4.9 prints a bare ρ). The 5:2 prolate
+//! fit is the thesis's stand-in for 1:2 spheroids, the 1:5 oblate fit for 1:10.
 //!
-//! Ranges: Sanjeevi's fits cover 0.1 <= Re <= 2000, Zastawny's 0.1 <= Re <= 300. Where the
-//! thesis is silent magsep continues them as follows (D-002-11) ([`STOKES_FLOOR`], [`range`]): below
-//! Re = 0.1 drag and lift follow Stokes scaling (C·Re constant, force ∝ |u − v|), the pitching
-//! torque coefficient is held (torque ∝ |u − v|², the first inertial order; a fore-aft
-//! symmetric body has no Stokes torque; erratum E-002-18) and C_R Re_r is held (Stokes rotational drag);
-//! above the upper limit the coefficients are frozen. The magnitudes returned here are
-//! >= 0 for every Re in range; the loads take the directions from the geometry.
+//! Ranges: Sanjeevi's fits cover 0.1 <= Re <= 2000, Zastawny's 0.1 <= Re <= 300. Where the thesis
+//! is silent magsep continues them as follows (D-002-11) ([`STOKES_FLOOR`], [`range`]): below Re =
+//! 0.1 drag and lift follow Stokes scaling (C·Re constant, force ∝ |u − v|), the pitching torque
+//! coefficient is held (torque ∝ |u − v|², the first inertial order; a fore-aft symmetric body has
+//! no Stokes torque; erratum E-002-18) and C_R Re_r is held (Stokes rotational drag); above the
+//! upper limit the coefficients are frozen. The magnitudes returned here are >= 0 for every Re in
+//! range; the loads take the directions from the geometry.
 
 /// Sanjeevi 2:5 drag a1..a10 (Table 4.4).
 pub const SANJEEVI_DRAG: [f64; 10] = [

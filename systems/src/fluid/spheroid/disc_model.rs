@@ -1,41 +1,42 @@
 //! Models of the 1:10 database ([`super::disc_table`], [T002 Tables 3.3-3.5]) in place of the
-//! thesis's neural network (3 × 300 ReLU, trained on 236 of the 266 points; its weights are
-//! not published, [T002 §3.4]).
+//! thesis's neural network (3 × 300 ReLU, trained on 236 of the 266 points; its weights are not
+//! published, [T002 §3.4]).
 //!
-//! The run-time model (D-002-12; [`DiscMethod::Spline`], [`disc_coefficients`]) is the tensor-product
-//! cubic spline in `(x, φ) = (ln(1 + Re_e), φ)` through all 266 nodes, stored as bicubic
-//! Hermite patches whose node derivatives come from 1-D splines (so it interpolates every node
-//! exactly and is C² in each variable). Interpolated quantities: `C_D Re_e`, `C_L Re_e` and
-//! `C_T`, the forms that tend to constants in the Stokes limit (C_D Re_e grows only from 35 to
-//! 108 over the table at 0°, while C_D varies 40-fold). The abscissa ln(1 + Re_e) is ≈ Re_e
-//! in the Stokes-Oseen range, where `C Re_e ≈ A + B Re_e`, and ≈ ln Re_e above; it was chosen
-//! over ln Re_e and over C_L, C_T Re_e by the held-out errors (leave one Re column out: max
-//! 0.65 / 2.6 / 1.9 % for drag / lift / torque against 0.73 / 3.4 / 2.5 % with ln Re_e).
-//! End conditions: natural in x; in φ, zero slope for drag (even about 0° and 90°) and
-//! natural for lift and torque (odd about 0° and 90°, where they vanish: a natural spline is
-//! exactly the odd continuation). Lift and torque nodes at φ = 0° and 90° (printed 0.01-0.08,
-//! noise) are set to 0.
+//! The run-time model (D-002-12; [`DiscMethod::Spline`], [`disc_coefficients`]) is the
+//! tensor-product cubic spline in `(x, φ) = (ln(1 + Re_e), φ)` through all 266 nodes, stored as
+//! bicubic Hermite patches whose node derivatives come from 1-D splines (so it interpolates every
+//! node exactly and is C² in each variable). Interpolated quantities: `C_D Re_e`, `C_L Re_e` and
+//! `C_T`, the forms that tend to constants in the Stokes limit (C_D Re_e grows only from 35 to 108
+//! over the table at 0°, while C_D varies 40-fold). The abscissa ln(1 + Re_e) is ≈ Re_e in the
+//! Stokes-Oseen range, where `C Re_e ≈ A + B Re_e`, and ≈ ln Re_e above; it was chosen over ln Re_e
+//! and over C_L, C_T Re_e by the held-out errors (leave one Re column out: max 0.65 / 2.6 / 1.9 %
+//! for drag / lift / torque against 0.73 / 3.4 / 2.5 % with ln Re_e). End conditions: natural in x;
+//! in φ, zero slope for drag (even about 0° and 90°) and natural for lift and torque (odd about 0°
+//! and 90°, where they vanish: a natural spline is exactly the odd continuation). Lift and torque
+//! nodes at φ = 0° and 90° (printed 0.01-0.08, noise) are set to 0.
 //!
-//! Held-out accuracy ([`super::disc_validation`], refits without the held-out nodes): leaving out one Re
-//! column at a time, mean errors 0.14 / 0.45 / 0.28 %; leaving out one angle row at a time,
-//! 0.08 / 0.35 / 0.49 % with maxima of 1.4 / 12 / 16 % at the 85° row and Re_e = 55.7, where
-//! lift and torque drop steeply to 0 at 90° (a feature no interpolant can recover from the
-//! 80° and 90° rows alone). The thesis's network: mean 1.5 % (drag), < 3 % (lift, torque) on
-//! 30 random held-out points.
+//! Held-out accuracy ([`super::disc_validation`], refits without the held-out nodes): leaving out
+//! one Re column at a time, mean errors 0.14 / 0.45 / 0.28 %; leaving out one angle row at a time,
+//! 0.08 / 0.35 / 0.49 % with maxima of 1.4 / 12 / 16 % at the 85° row and Re_e = 55.7, where lift
+//! and torque drop steeply to 0 at 90° (a feature no interpolant can recover from the 80° and 90°
+//! rows alone). The thesis's network: mean 1.5 % (drag), < 3 % (lift, torque) on 30 random held-out
+//! points.
 //!
-//! Outside the table (D-002-11): below Re_e = 0.464 drag and lift follow Stokes scaling (C·Re_e held,
-//! force ∝ |u − v|) and the torque coefficient is held (torque ∝ |u − v|², a fore-aft
-//! symmetric body has no Stokes torque, erratum E-002-18). Deviation: a constant lift coefficient (lift ∝
-//! |u − v|²) would be inconsistent with the table itself, whose 0.464 column already has the
-//! Stokes ratio C_L/C_D = (C_D90 − C_D0)/(C_D90 + C_D0) at 45° (0.196 against 0.185). Above
-//! Re_e = 55.7 (the steady-wake limit Re ≈ 120-130 of the database) the coefficients are
-//! frozen at the last column. φ is clamped to [0, π/2].
+//! Outside the table (D-002-11): below Re_e = 0.464 drag and lift follow Stokes scaling (C·Re_e
+//! held, force ∝ |u − v|) and the torque coefficient is held (torque ∝ |u − v|², a fore-aft
+//! symmetric body has no Stokes torque, erratum E-002-18). Deviation: a constant lift coefficient
+//! (lift ∝ |u − v|²) would be inconsistent with the table itself, whose 0.464 column already has
+//! the Stokes ratio C_L/C_D = (C_D90 − C_D0)/(C_D90 + C_D0) at 45° (0.196 against 0.185). Above
+//! Re_e = 55.7 (the steady-wake limit Re ≈ 120-130 of the database) the coefficients are frozen at
+//! the last column. φ is clamped to [0, π/2].
 //!
 //! The spline is hand-written: 14 × 19 nodes need a 60-line tridiagonal solver, and the
 //! per-direction end conditions above are not offered by the small interpolation crates.
-//! [`DiscMethod::Bilinear`] and [`DiscMethod::LeastSquares`] (Chebyshev polynomials of degree
-//! 5 in x times four Fourier modes in φ, 24 coefficients per quantity) are the alternatives
-//! compared by `magsep chart spheroid-model`.
+//! [`DiscMethod::Bilinear`] and [`DiscMethod::LeastSquares`] (Chebyshev polynomials of degree 5 in
+//! x times four Fourier modes in φ, 24 coefficients per quantity) are the alternatives compared by
+//! `magsep chart spheroid-model` (one Re column held out, mean errors drag / lift / torque:
+//! bilinear 1.4 / 4.0 / 0.44 % at ≈ 50 ns per evaluation of all three, spline 0.14 / 0.45 / 0.28 %
+//! at ≈ 85 ns, least squares 0.44 / 2.4 / 0.59 % at ≈ 250 ns).
 
 use super::correlations::Coefficients;
 use super::disc_table::{DRAG, LIFT, PHI_DEG, TORQUE, re_e};
@@ -74,6 +75,19 @@ pub struct Variant {
     pub times_re: [bool; 3],
     /// Shift of the abscissa.
     pub x_shift: f64,
+    /// If > 0, the abscissa is `Re_e^x_power` instead of the logarithm.
+    pub x_power: f64,
+}
+
+impl Variant {
+    /// The abscissa of Re_e.
+    pub fn abscissa(&self, re: f64) -> f64 {
+        if self.x_power > 0.0 {
+            re.powf(self.x_power)
+        } else {
+            (re + self.x_shift).ln()
+        }
+    }
 }
 
 impl Default for Variant {
@@ -81,6 +95,7 @@ impl Default for Variant {
         Self {
             times_re: TIMES_RE,
             x_shift: X_SHIFT,
+            x_power: 0.0,
         }
     }
 }
@@ -248,10 +263,7 @@ impl DiscModel {
     ) -> Self {
         let cols: Vec<usize> = cols.iter().copied().filter(|&j| j < NX).collect();
         let rows: Vec<usize> = rows.iter().copied().filter(|&i| i < NY).collect();
-        let xs: Vec<f64> = cols
-            .iter()
-            .map(|&j| (re_e(j) + variant.x_shift).ln())
-            .collect();
+        let xs: Vec<f64> = cols.iter().map(|&j| variant.abscissa(re_e(j))).collect();
         let re_range = match (cols.first(), cols.last()) {
             (Some(&a), Some(&b)) => (re_e(a), re_e(b)),
             _ => (f64::NAN, f64::NAN),
@@ -354,55 +366,68 @@ impl DiscModel {
         self.method
     }
 
-    /// The raw interpolated quantity q (0: C_D Re_e, 1: C_L Re_e, 2: C_T) at (x, y), with x and
-    /// y inside the fitted grid.
-    fn surface(&self, q: usize, x: f64, y: f64) -> f64 {
+    /// The raw interpolated quantities (C_D Re_e, C_L Re_e, C_T, or C per [`Variant`]) at
+    /// (x, y) inside the fitted grid; the cell and basis are found once for all three.
+    fn surfaces_at(&self, x: f64, y: f64) -> [f64; 3] {
         let (nx, ny) = (self.xs.len(), self.ys.len());
-        match &self.surfaces[q] {
-            Surface::Ls(coef) => {
-                let (Some(&x0), Some(&x1)) = (self.xs.first(), self.xs.last()) else {
+        if nx < 2 || ny < 2 {
+            return [0.0; 3];
+        }
+        if self.method == DiscMethod::LeastSquares {
+            let (x0, x1) = (self.xs[0], self.xs[nx - 1]);
+            let mut basis = [0.0; LS_NX * LS_NY];
+            return [0, 1, 2].map(|q| {
+                let Surface::Ls(coef) = &self.surfaces[q] else {
                     return 0.0;
                 };
-                let mut basis = [0.0; LS_NX * LS_NY];
                 Self::ls_basis(q, x, y, x0, x1, &mut basis);
                 basis.iter().zip(coef).map(|(a, b)| a * b).sum()
-            }
-            Surface::Grid { f, fx, fy, fxy } => {
-                if nx < 2 || ny < 2 {
-                    return 0.0;
-                }
-                let c = self.xs.partition_point(|&v| v <= x).clamp(1, nx - 1) - 1;
-                let r = self.ys.partition_point(|&v| v <= y).clamp(1, ny - 1) - 1;
-                let (hx, hy) = (self.xs[c + 1] - self.xs[c], self.ys[r + 1] - self.ys[r]);
-                let (t, u) = ((x - self.xs[c]) / hx, (y - self.ys[r]) / hy);
-                let idx = |rr: usize, cc: usize| rr * nx + cc;
-                if self.method == DiscMethod::Bilinear {
-                    return (1.0 - u) * ((1.0 - t) * f[idx(r, c)] + t * f[idx(r, c + 1)])
-                        + u * ((1.0 - t) * f[idx(r + 1, c)] + t * f[idx(r + 1, c + 1)]);
-                }
-                let h = |s: f64| {
-                    let (s2, s3) = (s * s, s * s * s);
-                    [
-                        2.0 * s3 - 3.0 * s2 + 1.0,
-                        s3 - 2.0 * s2 + s,
-                        -2.0 * s3 + 3.0 * s2,
-                        s3 - s2,
-                    ]
-                };
-                let (bx, by) = (h(t), h(u));
-                let mut v = 0.0;
-                for (dr, (pv, dv)) in [(0, (by[0], by[1])), (1, (by[2], by[3]))] {
-                    for (dc, (pu, du)) in [(0, (bx[0], bx[1])), (1, (bx[2], bx[3]))] {
-                        let k = idx(r + dr, c + dc);
-                        v += pv * pu * f[k]
-                            + pv * du * hx * fx[k]
-                            + dv * pu * hy * fy[k]
-                            + dv * du * hx * hy * fxy[k];
-                    }
-                }
-                v
-            }
+            });
         }
+        let c = self.xs.partition_point(|&v| v <= x).clamp(1, nx - 1) - 1;
+        let r = self.ys.partition_point(|&v| v <= y).clamp(1, ny - 1) - 1;
+        let (hx, hy) = (self.xs[c + 1] - self.xs[c], self.ys[r + 1] - self.ys[r]);
+        let (t, u) = ((x - self.xs[c]) / hx, (y - self.ys[r]) / hy);
+        let corners = [
+            r * nx + c,
+            r * nx + c + 1,
+            (r + 1) * nx + c,
+            (r + 1) * nx + c + 1,
+        ];
+        if self.method == DiscMethod::Bilinear {
+            let w = [(1.0 - u) * (1.0 - t), (1.0 - u) * t, u * (1.0 - t), u * t];
+            return [0, 1, 2].map(|q| match &self.surfaces[q] {
+                Surface::Grid { f, .. } => corners.iter().zip(w).map(|(&k, w)| w * f[k]).sum(),
+                Surface::Ls(_) => 0.0,
+            });
+        }
+        // cubic Hermite basis: value and slope weights at the two ends
+        let h = |s: f64| {
+            let (s2, s3) = (s * s, s * s * s);
+            [
+                2.0 * s3 - 3.0 * s2 + 1.0,
+                s3 - 2.0 * s2 + s,
+                -2.0 * s3 + 3.0 * s2,
+                s3 - s2,
+            ]
+        };
+        let (bx, by) = (h(t), h(u));
+        // per corner: weights of f, fx, fy, fxy
+        let mut w = [[0.0; 4]; 4];
+        for (k, wk) in w.iter_mut().enumerate() {
+            let (dr, dc) = (k / 2, k % 2);
+            let (pv, dv) = (by[2 * dr], by[2 * dr + 1]);
+            let (pu, du) = (bx[2 * dc], bx[2 * dc + 1]);
+            *wk = [pv * pu, pv * du * hx, dv * pu * hy, dv * du * hx * hy];
+        }
+        [0, 1, 2].map(|q| match &self.surfaces[q] {
+            Surface::Grid { f, fx, fy, fxy } => corners
+                .iter()
+                .zip(&w)
+                .map(|(&k, wk)| wk[0] * f[k] + wk[1] * fx[k] + wk[2] * fy[k] + wk[3] * fxy[k])
+                .sum(),
+            Surface::Ls(_) => 0.0,
+        })
     }
 
     /// `(C_D Re_e, C_L Re_e, C_T)` at any Re_e >= 0 and φ \[rad\], continued outside the
@@ -413,12 +438,16 @@ impl DiscModel {
             return (0.0, 0.0, 0.0);
         }
         let rc = re_e.clamp(re0, re1);
-        let x = (rc + self.variant.x_shift).ln();
+        let x = self.variant.abscissa(rc);
         let y = phi.clamp(0.0, std::f64::consts::FRAC_PI_2);
         // the coefficients C at the clamped Re_e
+        let raw = self.surfaces_at(x, y);
         let [d, l, t] = [0, 1, 2].map(|q| {
-            let v = self.surface(q, x, y);
-            if self.variant.times_re[q] { v / rc } else { v }
+            if self.variant.times_re[q] {
+                raw[q] / rc
+            } else {
+                raw[q]
+            }
         });
         // below the table C·Re_e is held (Stokes), above it C is frozen
         let re = if re_e < re0 { re0 } else { re_e };

@@ -36,7 +36,7 @@ pub struct HeldOut {
     pub max_absolute_at_symmetry: [f64; 3],
     /// Number of held-out nodes.
     pub nodes: usize,
-    /// (φ [deg], Re_e) of the node with the largest relative error, per coefficient.
+    /// (φ \[deg\], Re_e) of the node with the largest relative error, per coefficient.
     pub worst_node: [(f64, f64); 3],
 }
 

@@ -4,34 +4,31 @@
 //! With `u_r = u − v`, `û = u_r/|u_r|`, `e` the symmetry axis (lab, unit) and ρ the
 //! [`DragDensity`](super::DragDensity) choice:
 //!
-//! * `F_D = (π/8) C_D ρ d_e² |u_r| u_r`, `F_L = (π/8) C_L ρ d_e² |u_r|² e_PL`.
-//!   Erratum E-002-26: [T002 eq. 4.6] prints 1/8 for π/8 (½ C ρ A with A = π d²/4) and ρ_p where the
-//!   physics has ρ_f; the density is a switch, ρ_f by default.
-//! * `T_P = ½ C_T ρ_f (π/8) d_ref³ |u_r|² e_PT` with `d_ref³ = d_e³` for Sanjeevi and Zastawny
-//!   and `d_e² d_major` for the 1:10 database: its torque coefficient is `c_T = |T| /
-//!   (¼ρ_f u² A d)` with the equatorial A and d, re-based by `w^{−2/3}` only (eq. 3.9 and
-//!   §3.A), so the literal torque carries one d_major (erratum E-002-16, D-002-12). (The alternative d_e³ would make it
+//! * `F_D = (π/8) C_D ρ d_e² |u_r| u_r`, `F_L = (π/8) C_L ρ d_e² |u_r|² e_PL`. Erratum E-002-26:
+//!   [T002 eq. 4.6] prints 1/8 for π/8 (½ C ρ A with A = π d²/4) and ρ_p where the physics has ρ_f;
+//!   the density is a switch, ρ_f by default.
+//! * `T_P = ½ C_T ρ_f (π/8) d_ref³ |u_r|² e_PT` with `d_ref³ = d_e³` for Sanjeevi and Zastawny and
+//!   `d_e² d_major` for the 1:10 database: its torque coefficient is `c_T = |T| / (¼ρ_f u² A d)`
+//!   with the equatorial A and d, re-based by `w^{−2/3}` only (eq. 3.9 and §3.A), so the literal
+//!   torque carries one d_major (erratum E-002-16, D-002-12). (The alternative d_e³ would make it
 //!   smaller by w^{1/3} = 0.46; the thesis does not settle it.)
-//! * Incidence and directions (corrected, erratum E-002-27; eq. 4.7 and 4.11 are the elongated-particle forms,
-//!   which for the short axis of an oblate body give the complement of the incidence, the
-//!   wrong lift sign, and a "torque" in the plane of e and û):
-//!   `φ = arcsin|e·û|` (0 edge-on, π/2 broadside), `e_⊥ = e − (e·û)û`,
-//!   `e_PL = sgn(e·û) e_⊥/|e_⊥|`, `e_PT = sgn(e·û) (e × û)/|e × û|`, C_L, C_T >= 0. The torque
-//!   turns e towards ±û, i.e. the body towards broadside (the stable orientation).
+//! * Incidence and directions (corrected, erratum E-002-27; eq. 4.7 and 4.11 are the
+//!   elongated-particle forms, which for the short axis of an oblate body give the complement of
+//!   the incidence, the wrong lift sign, and a "torque" in the plane of e and û): `φ = arcsin|e·û|`
+//!   (0 edge-on, π/2 broadside), `e_⊥ = e − (e·û)û`, `e_PL = sgn(e·û) e_⊥/|e_⊥|`,
+//!   `e_PT = sgn(e·û) (e × û)/|e × û|`, C_L, C_T >= 0. The torque turns e towards ±û, i.e. the body
+//!   towards broadside (the stable orientation).
 //! * Reynolds number `Re = ρ_f |u_r| d_e / μ` (for the 1:10 database `Re_e`, the same thing).
-//! * Sphere: Schiller-Naumann (density free, so the switch does not apply), no lift, no
-//!   torque.
+//! * Sphere: Schiller-Naumann (density free, so the switch does not apply), no lift, no torque.
 //!
-//! Guards: zero slip, or a non-finite slip, gives zero loads; lift and torque are zero when
-//! |e_⊥| or |e·û| < 1e-12 (φ = 0 or 90°, where they vanish anyway) or when e is not finite.
-//! The drag is computed from `C_D Re` (finite as Re → 0) so the secant stiffness is finite at
-//! any slip.
+//! Guards: zero slip, or a non-finite slip, gives zero loads; lift and torque are zero when |e_⊥|
+//! or |e·û| < 1e-12 (φ = 0 or 90°, where they vanish anyway) or when e is not finite. The drag is
+//! computed from `C_D Re` (finite as Re → 0) so the secant stiffness is finite at any slip.
 //!
 //! Rotational resistance ([T002 eq. 4.9, 4.38]; sphere eq. 2.31-2.32; ρ_f and Re_r per errata
-//! E-002-28, E-002-29):
-//! `T_R = (1/64) ρ_f C_R |Δ| Δ d_e⁵`, `Δ = ½ω − Ω`, `Re_r = ρ_f d_e² |Δ| / μ`, with C_R from
-//! Zastawny mode 2 or Dennis for the sphere ([`crate::fluid::drag::rotational_drag`]). The
-//! secant stiffness is `(1/64) d_e³ μ (C_R Re_r)`.
+//! E-002-28, E-002-29): `T_R = (1/64) ρ_f C_R |Δ| Δ d_e⁵`, `Δ = ½ω − Ω`, `Re_r = ρ_f d_e² |Δ| / μ`,
+//! with C_R from Zastawny mode 2 or Dennis for the sphere
+//! ([`crate::fluid::drag::rotational_drag`]). The secant stiffness is `(1/64) d_e³ μ (C_R Re_r)`.
 
 use super::correlations::{
     ZASTAWNY_ROT_OBLATE15, ZASTAWNY_ROT_PROLATE52, continued, rotation_continued,

@@ -67,16 +67,11 @@ pub fn magnetic_torque_quadrature(
     let rot = DQuat::from_rotation_arc(DVec3::Z, e);
     let (dt, dp) = (PI / n_theta as f64, 2.0 * PI / n_phi as f64);
     let (mut torque, mut force) = (DVec3::ZERO, DVec3::ZERO);
-    let phis: Vec<(f64, f64)> = (0..n_phi)
-        .map(|k| {
-            let p = (k as f64 + 0.5) * dp;
-            (p.cos(), p.sin())
-        })
-        .collect();
     for i in 0..n_theta {
         let th = (i as f64 + 0.5) * dt;
         let (st, ct) = th.sin_cos();
-        for &(cp, sp) in &phis {
+        for k in 0..n_phi {
+            let (sp, cp) = ((k as f64 + 0.5) * dp).sin_cos();
             // body frame: r and the vector area element ∂r/∂θ × ∂r/∂φ (outward)
             let r = DVec3::new(a * st * cp, a * st * sp, c * ct);
             let n = DVec3::new(a * c * st * st * cp, a * c * st * st * sp, a * a * st * ct);

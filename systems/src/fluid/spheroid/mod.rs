@@ -128,6 +128,7 @@ pub enum DragDensity {
 /// assert!((h.equivalent_diameter - 8.6e-3 * 0.1f64.cbrt()).abs() < 1e-15);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SpheroidHydro {
     /// Drag, lift and pitching-torque correlation.
     pub correlation: Correlation,
@@ -143,7 +144,8 @@ pub struct SpheroidHydro {
     pub particle_density: f64,
     /// Dynamic viscosity μ [Pa s].
     pub viscosity: f64,
-    /// Density in the drag and lift.
+    /// Density in the drag and lift (default ρ_f).
+    #[serde(default)]
     pub drag_density: DragDensity,
 }
 
@@ -167,6 +169,20 @@ impl SpheroidHydro {
             viscosity,
             drag_density: DragDensity::Fluid,
         }
+    }
+
+    /// Semi-axes (a, c) \[m\]: a = d_major/2, c = a w with w = (d_e/d_major)³ (for
+    /// [`magnetic_torque()`]).
+    ///
+    /// ```
+    /// use magsep_systems::fluid::spheroid::SpheroidHydro;
+    /// let (a, c) = SpheroidHydro::new(8e-3, 0.1, 1400.0, 1450.0, 5.54e-3).semi_axes();
+    /// assert!((a - 4e-3).abs() < 1e-15 && (c - 4e-4).abs() < 1e-15);
+    /// ```
+    pub fn semi_axes(&self) -> (f64, f64) {
+        let a = 0.5 * self.major_diameter;
+        let w = (self.equivalent_diameter / self.major_diameter).powi(3);
+        (a, a * w)
     }
 
     /// The density multiplying drag and lift.
