@@ -75,6 +75,22 @@ fn quick_spheroid_model_chart_writes_its_svg() {
 }
 
 #[test]
+fn quick_flakes_chart_writes_its_svgs() {
+    let dir = temp_dir("flakes");
+    magsep::studies::fluid_charts::chart_flakes(&dir, true).unwrap();
+    assert_svgs(
+        &dir,
+        &[
+            "flakes_levitation.svg",
+            "flakes_orientation.svg",
+            "flakes_force_budget.svg",
+            "flakes_separation.svg",
+        ],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn quick_particle_fluid_bench_runs() {
     magsep::studies::fluid_charts::bench_particle_fluid(true, true).unwrap();
 }
