@@ -236,6 +236,8 @@ pub enum ChartKind {
     Separation,
     /// Flat particles (spheroids): levitation, orientation, force budget, separation.
     Flakes,
+    /// Binary collisions of 1:2 spheroids: delays against the impact factor.
+    FlakeCollisions,
     /// Models of the 1:10 spheroid's drag, lift and torque: error against cost.
     SpheroidModel,
 }
@@ -357,6 +359,7 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         ChartKind::Collisions => return fc::chart_collisions(out, quick),
         ChartKind::Separation => return fc::chart_separation(out, quick),
         ChartKind::Flakes => return fc::chart_flakes(out, quick),
+        ChartKind::FlakeCollisions => return fc::chart_flake_collisions(out, quick),
         ChartKind::SpheroidModel => return fc::chart_spheroid_model(out, quick),
         ChartKind::SqContact => {
             std::fs::create_dir_all(out)

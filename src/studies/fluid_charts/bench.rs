@@ -12,7 +12,10 @@
 //! * [`collision_bed_row`]: particle-steps per second of the pipeline with collisions in a
 //!   dense settling bed of 10⁴ glass spheres (1 mm, in water, no magnet) on the floor of a
 //!   periodic channel: first while the bed forms, then once it rests (every particle in
-//!   sustained contact).
+//!   sustained contact);
+//! * the spheroid rows of [`super::bench_spheroids`]: flakes of w = 0.5 and 0.1 against
+//!   spheres in the thesis's channel, with and without collisions, and the cost of one
+//!   spheroid contact query.
 //!
 //! History timings are minima over repetitions (the machine is shared), single-threaded.
 
@@ -134,6 +137,8 @@ pub fn bench_particle_fluid(as_json: bool, quick: bool) -> Result<(), BenchError
     history_rows(&mut rows, as_json, quick)?;
     pipeline_row(&mut rows, as_json, quick)?;
     collision_bed_row(&mut rows, as_json, quick)?;
+    super::bench_spheroids::flake_rows(&mut rows, as_json, quick)?;
+    super::bench_spheroids::contact_rows(&mut rows, as_json, quick)?;
     Ok(())
 }
 

@@ -7,12 +7,15 @@
 //! * `magsep chart collisions`: [`chart_collisions`].
 //! * `magsep chart separation`: [`chart_separation`].
 //! * `magsep chart flakes`: [`chart_flakes`] (spheroids, ch. 4).
+//! * `magsep chart flake-collisions`: [`chart_flake_collisions`] (1:2 spheroids, ch. 4).
 //! * `magsep chart spheroid-model`: [`chart_spheroid_model`] (thesis 002, ch. 3-4: models of
 //!   the 1:10 spheroid's coefficients, error against cost).
 //! * `magsep bench particle-fluid`: [`bench_particle_fluid`].
 
 mod bench;
+mod bench_spheroids;
 mod collisions;
+mod flake_collisions;
 mod flakes;
 mod history;
 mod levitation;
@@ -21,6 +24,7 @@ mod spheroid_model;
 
 pub use bench::bench_particle_fluid;
 pub use collisions::chart_collisions;
+pub use flake_collisions::chart_flake_collisions;
 pub use flakes::chart_flakes;
 pub use history::chart_history;
 pub use levitation::chart_levitation;
