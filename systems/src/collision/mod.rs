@@ -24,6 +24,7 @@ pub mod domain;
 pub mod engine;
 pub mod impulse;
 pub mod restitution;
+pub mod spheroid;
 pub mod toi;
 
 pub use domain::{CollisionDomain, PeriodicAxis};
