@@ -129,6 +129,7 @@ pub fn resolve_collisions(
         inv_masses: &ws.inv_mass,
         inv_inertias: InverseInertia::Scalar(&ws.inv_inertia),
         densities: &ws.densities,
+        spheroids: None,
     };
     let report = match ws.engine.step(arrays, &domain.0, &ws.model, cfg.dt) {
         Ok(r) => r,
