@@ -617,3 +617,5 @@ impl Sim<'_, '_> {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_spheroid;
