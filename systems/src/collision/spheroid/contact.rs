@@ -57,6 +57,11 @@ fn add_body(ev: &mut Eval, body: &PosedSpheroid, u: DVec3) {
     ev.h -= (m - outer(mu, mu) / (s * s)) / s;
 }
 
+/// The separating-axis function alone.
+fn value(a: &PosedSpheroid, b: &PosedSpheroid, d: DVec3, u: DVec3) -> f64 {
+    u.dot(d) - a.support_value(u) - b.support_value(u)
+}
+
 fn eval(a: &PosedSpheroid, b: &PosedSpheroid, d: DVec3, u: DVec3) -> Eval {
     let mut ev = Eval {
         f: u.dot(d),
@@ -89,7 +94,7 @@ fn ascend(
     for it in 0..MAX_ITERATIONS {
         let (t1, t2) = u.any_orthonormal_pair();
         let g = (t1.dot(ev.g), t2.dot(ev.g));
-        let gnorm = g.0.hypot(g.1);
+        let gnorm = (g.0 * g.0 + g.1 * g.1).sqrt();
         if gnorm <= tol {
             return Some((u, ev, true, it));
         }
@@ -112,7 +117,7 @@ fn ascend(
             -(a22 * g.0 - a12 * g.1) / det,
             -(-a12 * g.0 + a11 * g.1) / det,
         );
-        let mut len = xi.0.hypot(xi.1);
+        let mut len = (xi.0 * xi.0 + xi.1 * xi.1).sqrt();
         if len > radius {
             xi = (xi.0 * radius / len, xi.1 * radius / len);
             len = radius;
@@ -122,9 +127,9 @@ fn ascend(
             let Some(un) = (u + t1 * xi.0 + t2 * xi.1).try_normalize() else {
                 break;
             };
-            let evn = eval(a, b, d, un);
-            if evn.f.is_finite() && evn.f >= ev.f - 1e-15 * scale {
-                accepted = Some((un, evn));
+            let fnew = value(a, b, d, un);
+            if fnew.is_finite() && fnew >= ev.f - 1e-15 * scale {
+                accepted = Some((un, eval(a, b, d, un)));
                 break;
             }
             xi = (xi.0 * 0.25, xi.1 * 0.25);
@@ -209,7 +214,7 @@ pub fn spheroid_contact(
     .flatten()
     {
         let Some(u) = s.try_normalize() else { continue };
-        let f = eval(a, b, d, u).f;
+        let f = value(a, b, d, u);
         if f.is_finite() {
             seeds[count] = (f, u);
             count += 1;
@@ -251,7 +256,7 @@ pub fn spheroid_contact(
     let r = superquadric::contact(&sq(a), a.centre, qa, &sq(b), b.centre, qb, &opts, None);
     if r.overlap.is_finite() && r.normal.is_finite() && !r.is_fallback() {
         let u = r.normal;
-        return Some(finish(a, b, u, eval(a, b, d, u).f, true, spent));
+        return Some(finish(a, b, u, value(a, b, d, u), true, spent));
     }
     best.map(|(u, f)| finish(a, b, u, f, false, spent))
 }

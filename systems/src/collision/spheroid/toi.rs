@@ -10,11 +10,18 @@
 //! gap rate `ġ = u·(v_b + Ω_b×w_b − v_a − Ω_a×w_a)` (`w` the witness lever arms; the envelope
 //! theorem makes this the exact derivative). For the *fixed* axis `u` the separating-axis
 //! function `f_u(s) = u·d(s) − h_a(u, s) − h_b(u, s)` is a lower bound of the gap at every
-//! time `s` (equal at `t`), cheap to evaluate in closed form, and Lipschitz with constant
-//! `B_u = |u·(v_b − v_a)| + |u×Ω_a| R_a + |u×Ω_b| R_b` (`R` the bounding radii; the support
-//! value of a rotating body changes at `r·(u×Ω)`). Steps `Δs = (f_u − level)/B_u` therefore
-//! never jump over a time where the gap falls to `level`. Each outer iteration advances along
-//! `f_u` to `level` (at most 64 such steps), then recomputes the contact (warm-started):
+//! time `s` (equal at `t`), and cheap to evaluate in closed form together with its rate: with
+//! `p = u·e(s)`, `h = √(a² + k p²)` (`k = c² − a²`) and `ḣ = k p ṗ/h`, `ṗ = u·(Ω×e)`. Its rate
+//! is bounded by `B_u = |u·(v_b − v_a)| + |u×Ω_a| R_a + |u×Ω_b| R_b` (`R` the bounding radii;
+//! `ḣ = r·(u×Ω)` with `r` the support point) and its second derivative by
+//! `A_u = Σ [|k| w⊥ (w⊥ + |Ω|) + R² w⊥²] / min(a, c)` (`w⊥ = |u×Ω|`; from
+//! `ḧ = [k(ṗ² + p p̈) − ḣ²]/h`, `|ṗ| ≤ w⊥`, `|p̈| ≤ w⊥|Ω|`, `h ≥ min(a, c)`; translation is
+//! linear). From a time `s` with `D = f_u(s) − level > 0` the step
+//! `Δs = max(D/B_u, (ḟ_u + √(ḟ_u² + 2 A_u D))/A_u)` (the larger of the Lipschitz and the
+//! second-order Taylor certificate) never jumps over a time where `f_u`, hence the gap, falls to
+//! `level`; the second-order step keeps near-contact pairs that move apart or roll (small `D`,
+//! `ḟ_u ≥ 0`) from crawling. Each outer iteration advances along `f_u` to `level` (at most 64
+//! such steps), then recomputes the contact (warm-started):
 //! * apart (`g > δ_hit`): `level = δ_hit/2`, so the true gap stays positive;
 //! * in contact (`g ≤ δ_hit`) and approaching faster than `min_approach`: **impact at `t`**;
 //! * in contact but not approaching (grazing, sliding, separating, or approaching slower than
@@ -79,8 +86,46 @@ fn axis_at(e0: DVec3, omega: DVec3, t: f64) -> DVec3 {
     }
 }
 
+/// Support value `h = √(a² + k p²)` (`p = u·e`) of a rotating spheroid along a fixed unit `u` and
+/// its rate `ḣ = k p ṗ / h`, `ṗ = u·(Ω×e)`.
+fn support_and_rate(shape: &Spheroid, e: DVec3, omega: DVec3, u: DVec3) -> (f64, f64) {
+    let a2 = shape.equatorial * shape.equatorial;
+    let k = shape.polar * shape.polar - a2;
+    let p = u.dot(e);
+    let h = (a2 + k * p * p).max(0.0).sqrt();
+    let pdot = u.dot(omega.cross(e));
+    (h, k * p * pdot / h)
+}
+
+/// Bounds `(B, A)` on `|ḣ|` and `|ḧ|` of a spheroid rotating at `Ω`, along the fixed unit `u`
+/// (see the module header).
+fn rate_bounds(shape: &Spheroid, omega: DVec3, u: DVec3) -> (f64, f64) {
+    let w_perp = u.cross(omega).length();
+    let w = omega.length();
+    let r = shape.bounding_radius();
+    let k = (shape.polar * shape.polar - shape.equatorial * shape.equatorial).abs();
+    let accel = (k * w_perp * (w_perp + w) + r * r * w_perp * w_perp) / shape.min_semi_axis();
+    (r * w_perp, accel)
+}
+
+/// Largest `τ` certified by value `dist = f − level > 0`, rate `rate = ḟ` and the bounds
+/// `|ḟ| ≤ b`, `|f̈| ≤ acc`: the larger of the Lipschitz step `dist/b` and the positive root of
+/// `dist + rate τ − acc τ²/2`.
+fn safe_step(dist: f64, rate: f64, b: f64, acc: f64) -> f64 {
+    let first = if b > 0.0 { dist / b } else { f64::INFINITY };
+    let second = if acc > 0.0 {
+        (rate + (rate * rate + 2.0 * acc * dist).max(0.0).sqrt()) / acc
+    } else if rate < 0.0 {
+        dist / -rate
+    } else {
+        f64::INFINITY
+    };
+    first.max(second)
+}
+
 /// The outer loop (see the module header). `contact(t, warm)` gives `(g, ġ, u)`, `fixed(u, s)`
-/// the separating-axis function, `bound(u)` its Lipschitz constant.
+/// the separating-axis function and its rate, `bounds(u)` the bounds `(B, A)` on its first and
+/// second derivatives.
 #[allow(clippy::too_many_arguments)]
 fn advance(
     t0: f64,
@@ -90,8 +135,8 @@ fn advance(
     delta_pen: f64,
     warm: Option<DVec3>,
     mut contact: impl FnMut(f64, Option<DVec3>) -> Option<(f64, f64, DVec3)>,
-    fixed: impl Fn(DVec3, f64) -> f64,
-    bound: impl Fn(DVec3) -> f64,
+    fixed: impl Fn(DVec3, f64) -> (f64, f64),
+    bounds: impl Fn(DVec3) -> (f64, f64),
 ) -> Option<Impact> {
     let mut t = t0;
     let mut u = warm;
@@ -113,14 +158,14 @@ fn advance(
         } else {
             (-delta_pen).min(g - 0.01 * delta_pen)
         };
-        let b = bound(n);
-        if !(b > 0.0) || !b.is_finite() {
-            return None; // no relative motion along any axis: the gap cannot change
+        let (b, acc) = bounds(n);
+        if !(b.is_finite() && acc.is_finite()) {
+            return None;
         }
         let mut s = t;
-        let mut fs = g;
+        let (mut fs, mut rate) = fixed(n, s);
         for _ in 0..MAX_INNER {
-            let step = (fs - level) / b;
+            let step = safe_step(fs - level, rate, b, acc);
             if !(step > 0.0) {
                 break;
             }
@@ -128,8 +173,8 @@ fn advance(
             if s >= horizon {
                 return None;
             }
-            fs = fixed(n, s);
-            if !fs.is_finite() {
+            (fs, rate) = fixed(n, s);
+            if !(fs.is_finite() && rate.is_finite()) {
                 return None;
             }
             if fs - level <= 1e-3 * (g - level) {
@@ -224,10 +269,15 @@ pub fn spheroid_pair_toi(
         Some((c.geometry.gap, gdot, n))
     };
     let fixed = |u: DVec3, s: f64| {
-        let (pa, pb) = pose(s);
-        u.dot(pb.centre) - pa.support_value(u) - pb.support_value(u)
+        let (ha, hda) = support_and_rate(sa, axis_at(ea, wa, s), wa, u);
+        let (hb, hdb) = support_and_rate(sb, axis_at(eb, wb, s), wb, u);
+        (u.dot(dx + dv * s) - ha - hb, u.dot(dv) - hda - hdb)
     };
-    let bound = |u: DVec3| u.dot(dv).abs() + u.cross(wa).length() * ra + u.cross(wb).length() * rb;
+    let bounds = |u: DVec3| {
+        let (ba, aa) = rate_bounds(sa, wa, u);
+        let (bb, ab) = rate_bounds(sb, wb, u);
+        (u.dot(dv).abs() + ba + bb, aa + ab)
+    };
     advance(
         t0,
         horizon,
@@ -237,7 +287,7 @@ pub fn spheroid_pair_toi(
         warm,
         contact,
         fixed,
-        bound,
+        bounds,
     )
 }
 
@@ -302,10 +352,6 @@ pub fn spheroid_plane_toi(
         centre: x0 + v * t,
         axis: axis_at(e0, w, t),
     };
-    let gap = |t: f64| {
-        let p = posed(t);
-        plane.signed_distance(p.centre) - p.support_value(n)
-    };
     let contact = |t: f64, _warm: Option<DVec3>| {
         let p = posed(t);
         let h = p.support_value(n);
@@ -313,8 +359,14 @@ pub fn spheroid_plane_toi(
         let g = plane.signed_distance(p.centre) - h;
         Some((g, n.dot(v + w.cross(r_a)), -n))
     };
-    let fixed = |_u: DVec3, t: f64| gap(t);
-    let bound = |_u: DVec3| vn.abs() + n.cross(w).length() * r;
+    let fixed = |_u: DVec3, t: f64| {
+        let (h, hdot) = support_and_rate(s, axis_at(e0, w, t), w, n);
+        (plane.signed_distance(x0 + v * t) - h, vn - hdot)
+    };
+    let bounds = |_u: DVec3| {
+        let (b, acc) = rate_bounds(s, w, n);
+        (vn.abs() + b, acc)
+    };
     advance(
         t0,
         horizon,
@@ -324,6 +376,6 @@ pub fn spheroid_plane_toi(
         None,
         contact,
         fixed,
-        bound,
+        bounds,
     )
 }
