@@ -42,10 +42,13 @@
 //! * Spheroid–plane is closed form: with the unit plane normal `n_w` into the fluid,
 //!   `gap = n_w·(x − x_w) − √(n_wᵀ E⁻¹ n_w)`, deepest point `x − E⁻¹ n_w/√(n_wᵀ E⁻¹ n_w)`.
 //!
-//! Time of impact: see [`toi`](self::spheroid_pair_toi) in the `toi` submodule header.
+//! Time of impact: [`spheroid_pair_toi`] and [`spheroid_plane_toi`] (separating-axis
+//! conservative advancement; their submodule header states the method and the tolerances).
+//! Cost of one contact query: [`time_contact_queries`].
 //!
 //! All functions are NaN-safe: invalid shapes or non-finite poses give `None`.
 
+mod bench;
 mod contact;
 mod toi;
 
@@ -54,6 +57,7 @@ mod tests;
 #[cfg(test)]
 mod tests_toi;
 
+pub use bench::{ContactQueryTiming, time_contact_queries};
 pub use contact::{SpheroidContact, spheroid_contact, spheroid_plane_contact};
 pub use toi::{
     Impact, SPHEROID_CONTACT_TOLERANCE, SPHEROID_PENETRATION_TOLERANCE, spheroid_pair_toi,

@@ -53,7 +53,7 @@ use crate::collision::toi::{Ballistic, Plane, sphere_sphere_toi};
 /// Contact band `δ_hit` in units of the smallest semi-axis of the pair [-].
 pub const SPHEROID_CONTACT_TOLERANCE: f64 = 1e-3;
 /// Penetration tolerance `δ_pen` in units of the smallest semi-axis of the pair [-].
-pub const SPHEROID_PENETRATION_TOLERANCE: f64 = 1e-3;
+pub const SPHEROID_PENETRATION_TOLERANCE: f64 = 1e-2;
 
 const MAX_OUTER: u32 = 20_000;
 const MAX_INNER: u32 = 64;
