@@ -73,7 +73,7 @@
 //! relative to the sum of the bounding radii (`d_major` for equal discs). Without shapes the
 //! sphere path is unchanged (bitwise).
 
-use std::cmp::{Ordering, Reverse};
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use glam::DVec3;
@@ -83,7 +83,9 @@ use super::domain::CollisionDomain;
 use super::impulse::{CollisionLaw, FrictionRegime, RigidBody, collision_impulse};
 use super::restitution::{CollisionModel, Counterpart};
 use super::toi::{sphere_plane_toi, sphere_sphere_toi};
+use event::Event;
 
+mod event;
 mod projection;
 mod resting;
 mod shapes;
@@ -93,43 +95,6 @@ pub use types::{
     CollisionError, CollisionEvent, CollisionReport, CollisionStats, EngineConfig, InverseInertia,
     LastCollision, ParticleArrays, Partner, SpheroidArrays,
 };
-
-/// A predicted event. `hi ≥ N` encodes wall `hi − N`.
-#[derive(Debug, Clone, Copy)]
-struct Event {
-    time: f64,
-    lo: u32,
-    hi: u32,
-    owner: u32,
-    ver_lo: u32,
-    ver_hi: u32,
-}
-
-impl Event {
-    fn key(&self) -> (u32, u32, u32) {
-        (self.lo, self.hi, self.owner)
-    }
-}
-
-impl PartialEq for Event {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Event {}
-impl PartialOrd for Event {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Event {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.time
-            .total_cmp(&other.time)
-            .then_with(|| self.key().cmp(&other.key()))
-            .then_with(|| (self.ver_lo, self.ver_hi).cmp(&(other.ver_lo, other.ver_hi)))
-    }
-}
 
 /// Reusable event-driven collision stepper (holds its scratch buffers between steps).
 ///

@@ -91,7 +91,7 @@ impl Sim<'_, '_> {
         let xi = self.p.positions[i];
         let dx = self.domain.minimum_image(self.p.positions[j] - xi);
         let s = self.eng.radius[i] + self.eng.radius[j];
-        if !(dx.length() < s) {
+        if dx.length().partial_cmp(&s) != Some(std::cmp::Ordering::Less) {
             return 0.0;
         }
         let Some(c) = self.pair_contact(i, j, xi, dx, h) else {

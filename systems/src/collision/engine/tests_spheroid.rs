@@ -173,7 +173,10 @@ fn disc_bed(n: usize, cells: usize, seed: u64) -> (Discs, CollisionDomain) {
             rng.random_range(-1.0..1.0),
         )
         .normalize_or(DVec3::Z);
-        q.push(DQuat::from_axis_angle(axis, rng.random_range(0.0..6.28)));
+        q.push(DQuat::from_axis_angle(
+            axis,
+            rng.random_range(0.0..std::f64::consts::TAU),
+        ));
     }
     let mut d = Discs::new(x, q, disc, 1200.0);
     for v in &mut d.v {

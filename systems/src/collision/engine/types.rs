@@ -102,8 +102,9 @@ pub struct ParticleArrays<'a> {
     pub velocities: &'a mut [DVec3],
     /// In/out like `velocities` [rad/s].
     pub angular_velocities: &'a mut [DVec3],
-    /// Radii \[m\] (ignored for particles with a shape in `spheroids`, whose bounding radius
-    /// `max(a, c)` is used instead).
+    /// Radii \[m\]. Ignored when `spheroids` is given: the shapes are then authoritative (a
+    /// round shape is a sphere of that radius, others use their bounding radius `max(a, c)` for
+    /// the cell grid).
     pub radii: &'a [f64],
     /// Inverse masses [1/kg] (0: immovable particle).
     pub inv_masses: &'a [f64],

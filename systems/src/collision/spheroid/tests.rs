@@ -76,9 +76,8 @@ fn brute_distance(pa: &PosedSpheroid, qa: DQuat, pb: &PosedSpheroid, qb: DQuat) 
                 }
             }
         }
-        for k in 0..4 {
-            let w = win[k].1 * 0.35;
-            win[k] = (best.2[k], w);
+        for (w, centre) in win.iter_mut().zip(best.2) {
+            *w = (centre, w.1 * 0.35);
         }
     }
     (best.0, best.1.normalize())

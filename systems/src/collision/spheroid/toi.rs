@@ -166,7 +166,7 @@ fn advance(
         let (mut fs, mut rate) = fixed(n, s);
         for _ in 0..MAX_INNER {
             let step = safe_step(fs - level, rate, b, acc);
-            if !(step > 0.0) {
+            if step.is_nan() || step <= 0.0 {
                 break;
             }
             s += step;
