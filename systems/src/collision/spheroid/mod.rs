@@ -55,6 +55,8 @@ mod toi;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_impulse;
+#[cfg(test)]
 mod tests_toi;
 
 pub use bench::{ContactQueryTiming, time_contact_queries};

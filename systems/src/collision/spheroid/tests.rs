@@ -274,3 +274,19 @@ fn warm_start_converges_in_few_iterations() {
         assert!(c2.converged && c2.iterations <= 6, "{}", c2.iterations);
     }
 }
+
+#[test]
+fn contact_query_timing_hook_reports_converged_queries() {
+    for w in [1.0, 0.5, 0.2, 0.1] {
+        let t = time_contact_queries(2000, w, 3);
+        println!(
+            "w = {w}: cold {:.0} ns ({:.1} iterations), warm {:.0} ns, not converged {}",
+            t.cold_seconds_per_query * 1e9,
+            t.cold_iterations,
+            t.warm_seconds_per_query * 1e9,
+            t.not_converged
+        );
+        assert_eq!(t.not_converged, 0);
+        assert!(t.cold_seconds_per_query > 0.0 && t.warm_seconds_per_query > 0.0);
+    }
+}
