@@ -216,3 +216,6 @@ pub fn resolve_collisions(
     stats.capped_steps += u64::from(s.capped_particles > 0);
     stats.max_overlap = stats.max_overlap.max(s.max_overlap_after_projection);
 }
+
+#[cfg(test)]
+mod tests;
