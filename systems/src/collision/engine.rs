@@ -55,73 +55,46 @@
 //! * Positions are returned **unwrapped** (periodic wrapping is the caller's; see
 //!   [`CollisionDomain::wrap`]). Overlaps are reported relative to `r_i + r_j` (the mean
 //!   diameter; `2 r_i` for walls).
-//! * The inverse inertia is held fixed during the step (exact for spheres with isotropic inertia).
+//! * [`InverseInertia::Scalar`] and [`InverseInertia::Tensor`] are held fixed during the step
+//!   (exact for spheres with isotropic inertia); [`InverseInertia::Principal`] is rotated to the
+//!   lab frame with the orientation at the event time.
 //! * The warm start keys contacts by particle index: call
 //!   [`CollisionEngine::clear_warm_start`] when the particle order or set changes.
 //! * Deterministic: single-threaded, fixed orders everywhere; the same input gives bitwise the
 //!   same output.
 //!
-//! Spheres only (radii); spheroids need their shape and orientation arrays and a bisection TOI
-//! ([`super::toi`] header).
+//! **Spheroids** ([`SpheroidArrays`], thesis ch. 4): orientations rotate ballistically with the
+//! particle's local time; a pair with a non-round member uses the common-normal contact and the
+//! conservative-advancement TOI of [`super::spheroid`] (its approach filter is passed into the
+//! TOI as the minimum approach speed, so a slower touch does not hide a later faster one), walls
+//! the closed-form spheroid–plane gap; the resting solve and the projection use the contact
+//! normal and lever arms (translation only for the projection). The cell grid uses the bounding
+//! radii (a rotating body never leaves its bounding sphere). Overlaps of spheroids are reported
+//! relative to the sum of the bounding radii (`d_major` for equal discs). Without shapes the
+//! sphere path is unchanged (bitwise).
 
-use std::cmp::{Ordering, Reverse};
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use glam::{DMat3, DVec3};
+use glam::DVec3;
 
 use super::cells::Candidates;
 use super::domain::CollisionDomain;
 use super::impulse::{CollisionLaw, FrictionRegime, RigidBody, collision_impulse};
 use super::restitution::{CollisionModel, Counterpart};
-use super::toi::{
-    sphere_plane_contact, sphere_plane_toi, sphere_sphere_contact, sphere_sphere_toi,
-};
+use super::toi::{sphere_plane_toi, sphere_sphere_toi};
+use event::Event;
 
+mod event;
 mod projection;
 mod resting;
+mod shapes;
 mod types;
 
 pub use types::{
     CollisionError, CollisionEvent, CollisionReport, CollisionStats, EngineConfig, InverseInertia,
-    LastCollision, ParticleArrays, Partner,
+    LastCollision, ParticleArrays, Partner, SpheroidArrays,
 };
-
-/// A predicted event. `hi ≥ N` encodes wall `hi − N`.
-#[derive(Debug, Clone, Copy)]
-struct Event {
-    time: f64,
-    lo: u32,
-    hi: u32,
-    owner: u32,
-    ver_lo: u32,
-    ver_hi: u32,
-}
-
-impl Event {
-    fn key(&self) -> (u32, u32, u32) {
-        (self.lo, self.hi, self.owner)
-    }
-}
-
-impl PartialEq for Event {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Event {}
-impl PartialOrd for Event {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Event {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.time
-            .total_cmp(&other.time)
-            .then_with(|| self.key().cmp(&other.key()))
-            .then_with(|| (self.ver_lo, self.ver_hi).cmp(&(other.ver_lo, other.ver_hi)))
-    }
-}
 
 /// Reusable event-driven collision stepper (holds its scratch buffers between steps).
 ///
@@ -142,6 +115,7 @@ impl Ord for Event {
 ///     inv_masses: &[1.0; 2],
 ///     inv_inertias: InverseInertia::Scalar(&[1.0; 2]),
 ///     densities: &[1000.0; 2],
+///     spheroids: None,
 /// };
 /// let model = CollisionModel::dry(1.0, 0.0, 0.0);
 /// let mut engine = CollisionEngine::new(EngineConfig::default());
@@ -165,6 +139,8 @@ pub struct CollisionEngine {
     warm: Vec<resting::Cached>,
     rest_rows: Vec<usize>,
     rest_partners: Vec<u32>,
+    /// Bounding radii of this step (the radii for spheres).
+    radius: Vec<f64>,
 }
 
 impl CollisionEngine {
@@ -210,11 +186,14 @@ impl CollisionEngine {
         h: f64,
     ) -> Result<CollisionReport, CollisionError> {
         let n = p.positions.len();
-        let inertia_len = match p.inv_inertias {
-            InverseInertia::Scalar(s) => s.len(),
-            InverseInertia::Tensor(t) => t.len(),
+        let inertia_len = p.inv_inertias.len();
+        let (shapes_len, orientations_len) = match &p.spheroids {
+            Some(s) => (s.shapes.len(), s.orientations.len()),
+            None => (n, n),
         };
         for (name, found) in [
+            ("shapes", shapes_len),
+            ("orientations", orientations_len),
             ("velocities", p.velocities.len()),
             ("angular_velocities", p.angular_velocities.len()),
             ("radii", p.radii.len()),
@@ -292,6 +271,7 @@ impl Sim<'_, '_> {
         self.eng.count.clear();
         self.eng.count.resize(n, 0);
         self.eng.heap.clear();
+        self.fill_radii();
         self.speed_bound = self.max_speed();
         self.build_candidates();
         self.solve_resting();
@@ -323,8 +303,8 @@ impl Sim<'_, '_> {
     /// Candidate lists from the start positions for the current speed bound.
     fn build_candidates(&mut self) {
         let r_max = self
-            .p
-            .radii
+            .eng
+            .radius
             .iter()
             .copied()
             .filter(|r| r.is_finite())
@@ -332,7 +312,7 @@ impl Sim<'_, '_> {
         let reach = 2.0 * self.speed_bound * self.h + 0.1 * r_max;
         self.eng
             .candidates
-            .build(&self.eng.start, self.p.radii, self.domain, reach);
+            .build(&self.eng.start, &self.eng.radius, self.domain, reach);
     }
 
     /// Rebuilds the candidate lists for the current speed bound and re-predicts everyone at `now`.
@@ -353,6 +333,7 @@ impl Sim<'_, '_> {
 
     fn advance(&mut self, i: usize, t: f64) {
         self.p.positions[i] = self.position_at(i, t);
+        self.advance_orientation(i, t);
         self.eng.local_time[i] = t;
     }
 
@@ -371,7 +352,7 @@ impl Sim<'_, '_> {
         let (xi, vi, ri) = (
             self.position_at(i, now),
             self.p.velocities[i],
-            self.p.radii[i],
+            self.eng.radius[i],
         );
         let rest = self.eng.resting_partners(i);
         let rest_limit = 2.0 * self.resting_residual;
@@ -407,12 +388,27 @@ impl Sim<'_, '_> {
             }
             let dx = self.domain.minimum_image(self.position_at(j, now) - xi);
             let dv = self.p.velocities[j] - vi;
-            let s = ri + self.p.radii[j];
+            let s = ri + self.eng.radius[j];
             let resting = is_resting(j);
+            let busy = busy_i || self.eng.count[j] >= defer;
+            if !(self.is_round(i) && self.is_round(j)) {
+                let mut min_approach = tol * s;
+                if resting {
+                    min_approach = min_approach.max(rest_limit);
+                }
+                if busy {
+                    min_approach = min_approach.max(slow);
+                }
+                if let Some(hit) =
+                    self.spheroid_pair_impact(i, j, xi, dx, now, horizon, min_approach)
+                {
+                    offer(hit.time, i.min(j), i.max(j));
+                }
+                continue;
+            }
             if let Some(t) = sphere_sphere_toi(dx, dv, s, horizon) {
                 let d = dx + dv * t;
                 let approach = -dv.dot(d) / d.length();
-                let busy = busy_i || self.eng.count[j] >= defer;
                 if approach > tol * s
                     && !(resting && approach <= rest_limit)
                     && !(busy && approach < slow)
@@ -424,6 +420,21 @@ impl Sim<'_, '_> {
         for (w, plane) in self.domain.planes.iter().enumerate() {
             let approach = -vi.dot(plane.normal);
             let resting = is_resting(n + w);
+            if !self.is_round(i) {
+                let mut min_approach = tol * 2.0 * ri;
+                if resting {
+                    min_approach = min_approach.max(rest_limit);
+                }
+                if busy_i {
+                    min_approach = min_approach.max(slow);
+                }
+                if let Some(hit) =
+                    self.spheroid_wall_impact(i, xi, now, plane, horizon, min_approach)
+                {
+                    offer(hit.time, i, n + w);
+                }
+                continue;
+            }
             if let Some(t) = sphere_plane_toi(xi, vi, ri, plane, horizon)
                 && approach > tol * 2.0 * ri
                 && !(resting && approach <= rest_limit)
@@ -448,10 +459,7 @@ impl Sim<'_, '_> {
     fn body(&self, i: usize) -> RigidBody {
         RigidBody {
             inv_mass: self.p.inv_masses[i],
-            inv_inertia: match self.p.inv_inertias {
-                InverseInertia::Scalar(s) => DMat3::from_diagonal(DVec3::splat(s[i])),
-                InverseInertia::Tensor(t) => t[i],
-            },
+            inv_inertia: self.inv_inertia(i),
             velocity: self.p.velocities[i],
             angular_velocity: self.p.angular_velocities[i],
         }
@@ -479,16 +487,22 @@ impl Sim<'_, '_> {
         self.advance(lo, now);
         let (a, b, contact, other) = if wall {
             let plane = &self.domain.planes[hi - n];
-            let c = sphere_plane_contact(self.p.positions[lo], self.p.radii[lo], plane);
+            let c = self.wall_contact(lo, self.p.positions[lo], now, plane);
             (self.body(lo), RigidBody::fixed(), c, Counterpart::Wall)
         } else {
             self.advance(hi, now);
             let dx = self
                 .domain
                 .minimum_image(self.p.positions[hi] - self.p.positions[lo]);
-            let c = sphere_sphere_contact(dx, self.p.radii[lo], self.p.radii[hi]);
+            let Some(c) = self.pair_contact(lo, hi, self.p.positions[lo], dx, now) else {
+                // invalid shape or pose: nothing to resolve
+                self.report.stats.skipped_events += 1;
+                self.predict(lo, now);
+                self.predict(hi, now);
+                return;
+            };
             let other = Counterpart::Particle {
-                diameter: 2.0 * self.p.radii[hi],
+                diameter: self.diameter(hi),
                 density: self.p.densities[hi],
             };
             (self.body(lo), self.body(hi), c, other)
@@ -501,12 +515,9 @@ impl Sim<'_, '_> {
         }
         let approach =
             -(b.point_velocity(contact.r_b) - a.point_velocity(contact.r_a)).dot(contact.normal);
-        let law: CollisionLaw = self.model.law(
-            2.0 * self.p.radii[lo],
-            self.p.densities[lo],
-            other,
-            approach,
-        );
+        let law: CollisionLaw =
+            self.model
+                .law(self.diameter(lo), self.p.densities[lo], other, approach);
         if let Some(hit) = collision_impulse(&a, &b, &contact, &law) {
             let resting = self.model.is_resting(hit.approach_speed);
             let before = a.velocity;
@@ -571,3 +582,5 @@ impl Sim<'_, '_> {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_spheroid;

@@ -32,14 +32,10 @@
 //!
 //! **Periodic images** are the caller's job: pass the minimum-image `Δx`.
 //!
-//! **Extension point (spheroids, thesis ch. 4, not implemented).** [`CollisionShape`] is an enum so
-//! that a `Spheroid { equatorial_radius, polar_radius }` variant can be added. Its
-//! [`CollisionShape::time_of_impact`] would use [`Ballistic::orientation`] and
-//! [`Ballistic::angular_velocity`], computing the minimum distance (Jain et al.'s common normal, or
-//! the Perram–Wertheim contact function) inside a bisection/conservative-advancement search with
-//! the thesis tolerance `ε_t = 0.001 dt` ([T002 §4.2.1.3]); the spheroid–plane distance has the closed form
-//! `d = n_w·(x_c − x_w) − √(n_wᵀ E⁻¹ n_w)` (D-002-9 in docs/references.md). [`CollisionShape::contact`] would
-//! return the common-normal contact. The sphere paths stay analytic.
+//! **Spheroids** (thesis ch. 4) are handled by [`super::spheroid`] (common-normal contact,
+//! closed-form spheroid–plane gap, conservative-advancement TOI with rotation); the engine calls
+//! it directly from its shape arrays. [`CollisionShape`] stays the sphere-only enum of this
+//! module; the sphere paths stay analytic.
 
 use glam::{DQuat, DVec3};
 
@@ -233,8 +229,7 @@ impl Ballistic {
     }
 }
 
-/// Shape of a hard particle. Spheres only for now; spheroids are the planned second variant (see
-/// the module header for the extension point).
+/// Shape of a hard particle for the analytic sphere kernels (spheroids: [`super::spheroid`]).
 ///
 /// ```
 /// use glam::DVec3;

@@ -4,14 +4,27 @@
 //! velocities back, and marks each collided particle's Basset history for a restart with
 //! the jump v(t_c⁻) − v(t_c⁺) of its last collision (eq. 2.29; the thesis discards the
 //! pre-collision history).
+//!
+//! Spheroids (thesis 002, ch. 4): if any particle has [`Shape::Spheroid`], the engine gets every
+//! particle's semi-axes (other shapes enter as spheres of [`Shape::radius`], as without
+//! spheroids), the start-of-step orientations from `StepStartOrientation` (the integrator has
+//! already rotated `Orientation` to the end of the step; the engine re-rotates from the start with
+//! the post-collision angular velocities and `Orientation` is overwritten with its result), and
+//! the body-frame inverse principal moments `(1/I_x, 1/I_y, 1/I_z)` of `InertialBody::inertia`,
+//! with `1/I_z = 0` for spheroids: collisions do not change the spin about the symmetry axis
+//! (`I_z → ∞`, as the thesis suppresses that spin). Without spheroids the sphere-only path
+//! (isotropic inverse inertia `1/I_x`, no shapes) runs unchanged.
 
 use bevy_ecs::prelude::*;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
 
 use super::config::ParticleFluidConfig;
-use super::systems::{FluidDomain, PendingHistoryReset, StepStart};
-use crate::collision::{CollisionEngine, CollisionModel, InverseInertia, ParticleArrays};
+use super::systems::{FluidDomain, PendingHistoryReset, StepStart, StepStartOrientation};
+use crate::collision::spheroid::Spheroid;
+use crate::collision::{
+    CollisionEngine, CollisionModel, InverseInertia, ParticleArrays, SpheroidArrays,
+};
 
 /// What a collision does to the Basset history of the particles involved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -46,6 +59,9 @@ pub struct CollisionWorkspace {
     inv_mass: Vec<f64>,
     inv_inertia: Vec<f64>,
     densities: Vec<f64>,
+    shapes: Vec<Spheroid>,
+    orientations: Vec<DQuat>,
+    inv_principal: Vec<DVec3>,
 }
 
 impl CollisionWorkspace {
@@ -77,9 +93,11 @@ type CollideQuery<'w, 's> = Query<
     's,
     (
         &'static StepStart,
+        &'static StepStartOrientation,
         &'static Shape,
         &'static InertialBody,
         &'static mut Position,
+        &'static mut Orientation,
         &'static mut Velocity,
         &'static mut AngularVelocity,
         &'static mut PendingHistoryReset,
@@ -105,10 +123,29 @@ pub fn resolve_collisions(
     ws.inv_mass.clear();
     ws.inv_inertia.clear();
     ws.densities.clear();
+    ws.shapes.clear();
+    ws.orientations.clear();
+    ws.inv_principal.clear();
+    let mut any_spheroid = false;
     for &e in &ws.order {
-        let Ok((start, shape, body, _, v, w, _)) = q.get(e) else {
+        let Ok((start, start_q, shape, body, _, _, v, w, _)) = q.get(e) else {
             continue;
         };
+        let spheroid = match *shape {
+            Shape::Spheroid {
+                equatorial_radius,
+                polar_radius,
+            } => {
+                any_spheroid = true;
+                Spheroid::new(equatorial_radius, polar_radius)
+            }
+            _ => Spheroid::sphere(shape.radius()),
+        };
+        let inv = body.inertia.recip();
+        let axial = if shape.is_spheroid() { 0.0 } else { inv.z };
+        ws.shapes.push(spheroid);
+        ws.orientations.push(start_q.0);
+        ws.inv_principal.push(DVec3::new(inv.x, inv.y, axial));
         ws.positions.push(start.0);
         ws.velocities.push(v.0);
         ws.angular.push(w.0);
@@ -121,14 +158,26 @@ pub fn resolve_collisions(
         health.report("collision step: a particle entity disappeared");
         return;
     }
+    let (inv_inertias, spheroids) = if any_spheroid {
+        (
+            InverseInertia::Principal(&ws.inv_principal),
+            Some(SpheroidArrays {
+                shapes: &ws.shapes,
+                orientations: &mut ws.orientations,
+            }),
+        )
+    } else {
+        (InverseInertia::Scalar(&ws.inv_inertia), None)
+    };
     let arrays = ParticleArrays {
         positions: &mut ws.positions,
         velocities: &mut ws.velocities,
         angular_velocities: &mut ws.angular,
         radii: &ws.radii,
         inv_masses: &ws.inv_mass,
-        inv_inertias: InverseInertia::Scalar(&ws.inv_inertia),
+        inv_inertias,
         densities: &ws.densities,
+        spheroids,
     };
     let report = match ws.engine.step(arrays, &domain.0, &ws.model, cfg.dt) {
         Ok(r) => r,
@@ -141,10 +190,13 @@ pub fn resolve_collisions(
     // the end of this step, as the next step's history system computes it (step * dt)
     let t_end = (clock.step + 1) as f64 * clock.dt;
     for (k, &e) in ws.order.iter().enumerate() {
-        let Ok((_, _, _, mut x, mut v, mut w, mut reset)) = q.get_mut(e) else {
+        let Ok((_, _, _, _, mut x, mut o, mut v, mut w, mut reset)) = q.get_mut(e) else {
             continue;
         };
         x.0 = ws.positions[k];
+        if any_spheroid {
+            o.0 = ws.orientations[k];
+        }
         v.0 = ws.velocities[k];
         w.0 = ws.angular[k];
         if ws.history == CollisionHistory::Keep {
@@ -164,3 +216,6 @@ pub fn resolve_collisions(
     stats.capped_steps += u64::from(s.capped_particles > 0);
     stats.max_overlap = stats.max_overlap.max(s.max_overlap_after_projection);
 }
+
+#[cfg(test)]
+mod tests;

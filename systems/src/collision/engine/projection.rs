@@ -4,6 +4,8 @@
 //! until no overlap exceeds `projection_tolerance` or `projection_sweeps` sweeps are done. The
 //! sweep direction alternates (symmetric Gauss–Seidel); a forward sweep, which treats the walls
 //! last, ends the projection when the budget allows, so that no particle is left in a wall.
+//! Pairs with a spheroid are pushed apart along their contact normal by the penetration depth,
+//! a spheroid out of a wall along the wall normal (translations only; orientations are kept).
 
 use glam::DVec3;
 
@@ -63,7 +65,10 @@ impl Sim<'_, '_> {
 
     /// Corrects (if `fix`) and returns the relative overlap of the pair `(i, j)`.
     fn separate(&mut self, i: usize, j: usize, fix: bool) -> f64 {
-        let (x, r, w) = (&mut *self.p.positions, self.p.radii, self.p.inv_masses);
+        if !(self.is_round(i) && self.is_round(j)) {
+            return self.separate_spheroids(i, j, fix);
+        }
+        let (x, r, w) = (&mut *self.p.positions, &self.eng.radius, self.p.inv_masses);
         let dx = self.domain.minimum_image(x[j] - x[i]);
         let dist = dx.length();
         let s = r[i] + r[j];
@@ -80,15 +85,47 @@ impl Sim<'_, '_> {
         overlap / s
     }
 
+    /// [`Self::separate`] for a pair with a spheroid: along the contact normal.
+    fn separate_spheroids(&mut self, i: usize, j: usize, fix: bool) -> f64 {
+        let h = self.h;
+        let xi = self.p.positions[i];
+        let dx = self.domain.minimum_image(self.p.positions[j] - xi);
+        let s = self.eng.radius[i] + self.eng.radius[j];
+        if dx.length().partial_cmp(&s) != Some(std::cmp::Ordering::Less) {
+            return 0.0;
+        }
+        let Some(c) = self.pair_contact(i, j, xi, dx, h) else {
+            return 0.0;
+        };
+        let overlap = -c.gap;
+        if overlap <= 0.0 || overlap.is_nan() {
+            return 0.0;
+        }
+        let w = self.p.inv_masses;
+        let wsum = w[i] + w[j];
+        if fix && wsum > 0.0 {
+            self.p.positions[i] -= c.normal * (overlap * w[i] / wsum);
+            self.p.positions[j] += c.normal * (overlap * w[j] / wsum);
+        }
+        overlap / s
+    }
+
     /// Particle–wall pass; returns the largest relative overlap seen.
     fn sweep_walls(&mut self, fix: bool, backward: bool) -> f64 {
         let mut worst = 0.0f64;
-        let (x, r, w) = (&mut *self.p.positions, self.p.radii, self.p.inv_masses);
-        let n = x.len();
+        let n = self.p.positions.len();
+        let h = self.h;
         for k in 0..n {
             let i = if backward { n - 1 - k } else { k };
-            for plane in &self.domain.planes {
-                let overlap = r[i] - plane.signed_distance(x[i]);
+            for p in 0..self.domain.planes.len() {
+                let plane = self.domain.planes[p];
+                let x = self.p.positions[i];
+                let overlap = if self.p.spheroids.is_none() {
+                    self.eng.radius[i] - plane.signed_distance(x)
+                } else {
+                    -self.wall_contact(i, x, h, &plane).gap
+                };
+                let (x, r, w) = (&mut *self.p.positions, &self.eng.radius, self.p.inv_masses);
                 if overlap <= 0.0 || overlap.is_nan() {
                     continue;
                 }

@@ -23,7 +23,7 @@ use glam::DVec3;
 
 use super::{CollisionEvent, FrictionRegime, InverseInertia, LastCollision, Partner, Sim};
 use crate::collision::impulse::RigidBody;
-use crate::collision::toi::{ContactGeometry, sphere_plane_contact, sphere_sphere_contact};
+use crate::collision::toi::ContactGeometry;
 
 /// A cached resting-contact impulse (on the partner `j`; `j ≥ N` is wall `j − N`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,6 +63,7 @@ impl Sim<'_, '_> {
         match self.p.inv_inertias {
             InverseInertia::Scalar(s) => x * s[i],
             InverseInertia::Tensor(t) => t[i] * x,
+            InverseInertia::Principal(_) => self.inv_inertia(i) * x,
         }
     }
 
@@ -155,19 +156,24 @@ impl Sim<'_, '_> {
             return;
         }
         let n = self.n();
+        let margin = self.model.rest_speed * self.h;
         for i in 0..n {
             for &j in self.eng.candidates.of(i) {
                 let j = j as usize;
                 if j > i {
-                    let dx = self
-                        .domain
-                        .minimum_image(self.p.positions[j] - self.p.positions[i]);
-                    let geo = sphere_sphere_contact(dx, self.p.radii[i], self.p.radii[j]);
-                    contacts.extend(self.make_contact(i, j, geo));
+                    let xi = self.p.positions[i];
+                    let dx = self.domain.minimum_image(self.p.positions[j] - xi);
+                    let bound = self.eng.radius[i] + self.eng.radius[j] + margin;
+                    if !(self.is_round(i) && self.is_round(j)) && dx.length() > bound {
+                        continue; // bounding spheres apart: skip the contact solve
+                    }
+                    if let Some(geo) = self.pair_contact(i, j, xi, dx, 0.0) {
+                        contacts.extend(self.make_contact(i, j, geo));
+                    }
                 }
             }
             for (w, plane) in self.domain.planes.iter().enumerate() {
-                let geo = sphere_plane_contact(self.p.positions[i], self.p.radii[i], plane);
+                let geo = self.wall_contact(i, self.p.positions[i], 0.0, plane);
                 contacts.extend(self.make_contact(i, n + w, geo));
             }
         }
@@ -218,9 +224,9 @@ impl Sim<'_, '_> {
                 let c = &mut contacts[if backward { m - 1 - k } else { k }];
                 let (i, j) = c.ij();
                 let s = if j < n {
-                    self.p.radii[i] + self.p.radii[j]
+                    self.eng.radius[i] + self.eng.radius[j]
                 } else {
-                    2.0 * self.p.radii[i]
+                    2.0 * self.eng.radius[i]
                 };
                 let dv = self.relax(c, mu);
                 worst = worst.max(dv);

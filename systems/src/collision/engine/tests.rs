@@ -47,6 +47,7 @@ impl Spheres {
             inv_masses: &self.inv_m,
             inv_inertias: InverseInertia::Scalar(&self.inv_i),
             densities: &self.rho,
+            spheroids: None,
         };
         engine.step(arrays, domain, model, h).unwrap()
     }
@@ -254,6 +255,7 @@ fn invalid_input_is_an_error() {
         inv_masses: &s.inv_m,
         inv_inertias: InverseInertia::Scalar(&s.inv_i),
         densities: &s.rho,
+        spheroids: None,
     };
     let err = engine.step(arrays, &CollisionDomain::unbounded(), &elastic(), 1e-3);
     assert!(matches!(
@@ -272,6 +274,7 @@ fn invalid_input_is_an_error() {
         inv_masses: &s.inv_m,
         inv_inertias: InverseInertia::Scalar(&s.inv_i),
         densities: &s.rho,
+        spheroids: None,
     };
     let err = engine.step(arrays, &CollisionDomain::unbounded(), &elastic(), f64::NAN);
     assert!(matches!(err, Err(CollisionError::InvalidStep(_))));

@@ -1,8 +1,9 @@
 //! Public input, output and settings types of the collision step.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 
 use crate::collision::impulse::FrictionRegime;
+use crate::collision::spheroid::Spheroid;
 
 /// Settings of the event loop.
 ///
@@ -62,8 +63,34 @@ impl Default for EngineConfig {
 pub enum InverseInertia<'a> {
     /// Isotropic `I⁻¹ = s 𝕀` (spheres) [1/(kg m²)].
     Scalar(&'a [f64]),
-    /// Full tensors [1/(kg m²)].
+    /// Full tensors [1/(kg m²)], held fixed during the step.
     Tensor(&'a [DMat3]),
+    /// Body-frame inverse principal moments `(1/I_x, 1/I_y, 1/I_z)` [1/(kg m²)]; the world tensor
+    /// `R diag(·) Rᵀ` is recomputed from the current orientation at every use (identity
+    /// orientation without [`SpheroidArrays`]). A zero entry suppresses spin about that body
+    /// axis (`I → ∞`), e.g. `(1/I_x, 1/I_x, 0)` for a spheroid whose axial spin is neglected.
+    Principal(&'a [DVec3]),
+}
+
+impl InverseInertia<'_> {
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            Self::Scalar(s) => s.len(),
+            Self::Tensor(t) => t.len(),
+            Self::Principal(p) => p.len(),
+        }
+    }
+}
+
+/// Shapes and orientations of non-spherical particles.
+#[derive(Debug)]
+pub struct SpheroidArrays<'a> {
+    /// Per particle semi-axes (symmetry axis body z). A particle with equal semi-axes is a sphere
+    /// of that radius and keeps the analytic sphere path with other spheres.
+    pub shapes: &'a [Spheroid],
+    /// In: body→lab orientations at the start of the step; out: at its end (rotated
+    /// ballistically between collisions with the post-collision angular velocities).
+    pub orientations: &'a mut [DQuat],
 }
 
 /// The particle arrays of one step, all of length `N`, in a stable particle order.
@@ -75,7 +102,9 @@ pub struct ParticleArrays<'a> {
     pub velocities: &'a mut [DVec3],
     /// In/out like `velocities` [rad/s].
     pub angular_velocities: &'a mut [DVec3],
-    /// Radii \[m\].
+    /// Radii \[m\]. Ignored when `spheroids` is given: the shapes are then authoritative (a
+    /// round shape is a sphere of that radius, others use their bounding radius `max(a, c)` for
+    /// the cell grid).
     pub radii: &'a [f64],
     /// Inverse masses [1/kg] (0: immovable particle).
     pub inv_masses: &'a [f64],
@@ -83,6 +112,8 @@ pub struct ParticleArrays<'a> {
     pub inv_inertias: InverseInertia<'a>,
     /// Densities (for the wet restitution) [kg/m³].
     pub densities: &'a [f64],
+    /// Shapes and orientations; `None`: all particles are spheres of `radii` (the analytic path).
+    pub spheroids: Option<SpheroidArrays<'a>>,
 }
 
 /// The other body of a collision.
