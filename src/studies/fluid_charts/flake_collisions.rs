@@ -116,7 +116,7 @@ fn delay(pair: Option<f64>, alone: Option<f64>) -> Option<f64> {
 pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError> {
     std::fs::create_dir_all(out)
         .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
-    let duration = if quick { 6.0 } else { 30.0 };
+    let duration = if quick { 20.0 } else { 40.0 };
     let impacts: Vec<f64> = if quick {
         vec![0.06, 0.32]
     } else {
