@@ -24,4 +24,5 @@ mod pipeline_framework;
 mod scene_fuzz;
 mod schedule;
 mod signals;
+mod spheroid_collisions;
 mod spheroids;

@@ -19,14 +19,21 @@ use crate::studies::bench::{BenchError, emit};
 const MANY: &str = include_str!("../../../scenes/flakes_case4.toml");
 
 /// The pipeline rows.
-pub(super) fn flake_rows(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(), BenchError> {
+pub(super) fn flake_rows(
+    rows: &mut Vec<Value>,
+    as_json: bool,
+    quick: bool,
+) -> Result<(), BenchError> {
     let (phi, steps) = if quick { (0.002, 40u64) } else { (0.01, 300) };
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     for w in [1.0, 0.5, 0.1] {
         for collisions in [false, true] {
             let text = MANY
                 .replace("aspect_ratio = 0.5", &format!("aspect_ratio = {w}"))
-                .replace("volume_fraction = 0.01 ", &format!("volume_fraction = {phi} "))
+                .replace(
+                    "volume_fraction = 0.01 ",
+                    &format!("volume_fraction = {phi} "),
+                )
                 .replace(
                     "terms = { collisions = false }",
                     &format!("terms = {{ collisions = {collisions} }}"),

@@ -93,7 +93,9 @@ fn variant(impact: f64, duration: f64, only: Option<usize>) -> String {
             &format!("[[{}, 0.075, 0.0075]]", 0.075 + impact * 5e-3),
         );
     if let Some(k) = only {
-        let i0 = s.find("[[particles]]                # sinking").unwrap_or(0);
+        let i0 = s
+            .find("[[particles]]                # sinking")
+            .unwrap_or(0);
         let i1 = s.find("[[particles]]                # rising").unwrap_or(0);
         let rec = s.find("[record]").unwrap_or(s.len());
         s = if k == 0 {
@@ -159,12 +161,18 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
         .series(Series::new("sinking PVC-U", sink.clone()).style(Style::LineMarkers))
         .series(Series::new("rising POM", rise.clone()).style(Style::LineMarkers))
         .series(
-            Series::new("thesis mean, sinking (experiment)", vec![(0.5, THESIS_MEAN.0)])
-                .style(Style::Markers),
+            Series::new(
+                "thesis mean, sinking (experiment)",
+                vec![(0.5, THESIS_MEAN.0)],
+            )
+            .style(Style::Markers),
         )
         .series(
-            Series::new("thesis mean, rising (experiment)", vec![(0.5, THESIS_MEAN.1)])
-                .style(Style::Markers),
+            Series::new(
+                "thesis mean, rising (experiment)",
+                vec![(0.5, THESIS_MEAN.1)],
+            )
+            .style(Style::Markers),
         );
     let p1 = out.join("flake_collisions_delays.svg");
     write_svg(&p1, &delays.to_svg(640.0, 420.0)).map_err(runtime)?;
