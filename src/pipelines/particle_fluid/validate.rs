@@ -231,7 +231,7 @@ fn validate_group(
             let w = c / a;
             check(
                 errors,
-                !(w > 1.0 + 1e-12 || w < MIN_ASPECT_RATIO),
+                w.is_nan() || (MIN_ASPECT_RATIO..=1.0 + 1e-12).contains(&w),
                 &format!("{p}.shape"),
                 || {
                     format!(

@@ -75,7 +75,7 @@ fn track(text: &str, every: u64) -> Result<(Vec<Track>, Value), BenchError> {
         for (k, r) in rows.iter().enumerate() {
             let accel = last_v[k].map(|v| (r.velocity - v) / dt);
             last_v[k] = Some(r.velocity);
-            if step % every != 0 {
+            if !step.is_multiple_of(every) {
                 continue;
             }
             let tr = &mut tracks[k];
