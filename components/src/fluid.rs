@@ -206,6 +206,10 @@ pub struct ParticleFluidStats {
     pub sliding: u64,
     /// Approaches slower than the rest speed, treated as fully inelastic.
     pub resting: u64,
+    /// Contact impulses of the resting-contact solve (touching pairs at the start of a step;
+    /// not counted in `particle_collisions`, but each is a collision for the Basset history).
+    #[serde(default)]
+    pub resting_contacts: u64,
     /// Steps whose collision-event budget ran out.
     pub capped_steps: u64,
     /// Largest overlap left after a step, relative to the pair's mean diameter.

@@ -6,7 +6,9 @@
 //! Hard-ellipsoid collisions with e = 0.1 and μ = 0.05, the Basset history reset at each
 //! collision, one-way coupled.
 //!
-//! The delay of a particle is t_l(pair)/t_l(alone) − 1. Charts:
+//! The delay of a particle is t_l(pair)/t_l(alone) − 1, for the thesis's history rule at a
+//! collision (`reset`, eq. 2.29: every contact, a grazing one too, discards the history before
+//! it) and for `keep`. Charts:
 //! * `flake_collisions_delays.svg`: the delays against I, with the thesis's experimental means
 //!   for 1:2 spheroids (−7 % sinking, +33 % rising, over I in [0, 1]);
 //! * `flake_collisions_trajectories.svg`: heights and tilts of both particles against time for
@@ -85,9 +87,13 @@ fn run(text: &str) -> Result<RunOut, BenchError> {
 }
 
 /// The scene for impact factor `impact` over `duration`, keeping only group `only` if given.
-fn variant(impact: f64, duration: f64, only: Option<usize>) -> String {
+fn variant(impact: f64, rule: &str, duration: f64, only: Option<usize>) -> String {
     let mut s = SCENE
         .replace("duration = 12.0 ", &format!("duration = {duration} "))
+        .replace(
+            "friction = 0.05",
+            &format!("friction = 0.05\nhistory = \"{rule}\""),
+        )
         .replace(
             "[[0.0753, 0.075, 0.0075]]",
             &format!("[[{}, 0.075, 0.0075]]", 0.075 + impact * 5e-3),
@@ -126,27 +132,34 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
     };
     let alone: Vec<RunOut> = [0usize, 1]
         .par_iter()
-        .map(|&k| run(&variant(0.06, duration, Some(k))))
+        .map(|&k| run(&variant(0.06, "reset", duration, Some(k))))
         .collect::<Result<_, _>>()?;
-    let pairs: Vec<RunOut> = impacts
+    let rules = ["reset", "keep"];
+    let jobs: Vec<(f64, &str)> = rules
+        .iter()
+        .flat_map(|r| impacts.iter().map(move |&i| (i, *r)))
+        .collect();
+    let pairs: Vec<RunOut> = jobs
         .par_iter()
-        .map(|&i| run(&variant(i, duration, None)))
+        .map(|(i, r)| run(&variant(*i, r, duration, None)))
         .collect::<Result<_, _>>()?;
     let (t_sink, t_rise) = (alone[0].levitation[0], alone[1].levitation[0]);
     let mut rows = Vec::new();
-    let (mut sink, mut rise) = (Vec::new(), Vec::new());
-    for (impact, p) in impacts.iter().zip(&pairs) {
+    // per rule: (sinking, rising) delay points
+    let mut curves: Vec<(Vec<(f64, f64)>, Vec<(f64, f64)>)> = vec![Default::default(); 2];
+    for ((impact, rule), p) in jobs.iter().zip(&pairs) {
         let (a, b) = (p.levitation[0], p.levitation[1]);
         let (da, db) = (delay(a, t_sink), delay(b, t_rise));
+        let curve = &mut curves[usize::from(*rule == "keep")];
         if let Some(d) = da {
-            sink.push((*impact, d));
+            curve.0.push((*impact, d));
         }
         if let Some(d) = db {
-            rise.push((*impact, d));
+            curve.1.push((*impact, d));
         }
         let max_tilt = |k: usize| p.tilts[k].iter().copied().fold(0.0, f64::max);
         rows.push(json!({
-            "impact_factor": impact,
+            "impact_factor": impact, "history": rule,
             "levitation_time_sinking": a, "levitation_time_rising": b,
             "delay_sinking": da, "delay_rising": db,
             "max_tilt_sinking_deg": max_tilt(0), "max_tilt_rising_deg": max_tilt(1),
@@ -154,12 +167,22 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
         }));
     }
     let mean = |v: &[(f64, f64)]| v.iter().map(|p| p.1).sum::<f64>() / v.len().max(1) as f64;
-    let delays = Chart::new("levitation delay of 1:2 spheroids against the impact factor")
+    let mut delays = Chart::new("levitation delay of 1:2 spheroids against the impact factor")
         .x_label("I = lateral distance / d_major")
         .y_label("t_l(pair) / t_l(alone) - 1")
-        .legend(LegendPosition::TopRight)
-        .series(Series::new("sinking PVC-U", sink.clone()).style(Style::LineMarkers))
-        .series(Series::new("rising POM", rise.clone()).style(Style::LineMarkers))
+        .legend(LegendPosition::TopRight);
+    for (rule, (sink, rise)) in rules.iter().zip(&curves) {
+        delays = delays
+            .series(
+                Series::new(format!("sinking PVC-U, history {rule}"), sink.clone())
+                    .style(Style::LineMarkers),
+            )
+            .series(
+                Series::new(format!("rising POM, history {rule}"), rise.clone())
+                    .style(Style::LineMarkers),
+            );
+    }
+    let delays = delays
         .series(
             Series::new(
                 "thesis mean, sinking (experiment)",
@@ -180,8 +203,8 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
         "Binary collisions of 1:2 spheroids (thesis 002, figs. 4.10-4.12)",
         2,
     );
-    for (i, p) in impacts.iter().zip(&pairs) {
-        if !(i - 0.06).abs().lt(&1e-9) && !(i - 0.32).abs().lt(&1e-9) {
+    for ((i, rule), p) in jobs.iter().zip(&pairs) {
+        if *rule != "reset" || (!(i - 0.06).abs().lt(&1e-9) && !(i - 0.32).abs().lt(&1e-9)) {
             continue;
         }
         let pts = |v: &[f64]| -> Vec<(f64, f64)> {
@@ -208,7 +231,8 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
         "quick": quick,
         "alone": {"sinking": t_sink, "rising": t_rise},
         "pairs": rows,
-        "mean_delay": {"sinking": mean(&sink), "rising": mean(&rise)},
+        "mean_delay": rules.iter().zip(&curves).map(|(r, (a, b))| json!({
+            "history": r, "sinking": mean(a), "rising": mean(b)})).collect::<Vec<_>>(),
         "thesis_mean_delay": {"sinking": THESIS_MEAN.0, "rising": THESIS_MEAN.1},
     }))
 }

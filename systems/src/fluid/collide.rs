@@ -213,6 +213,7 @@ pub fn resolve_collisions(
     stats.sticking += s.stick as u64;
     stats.sliding += s.slide as u64;
     stats.resting += s.resting as u64;
+    stats.resting_contacts += s.resting_contacts as u64;
     stats.capped_steps += u64::from(s.capped_particles > 0);
     stats.max_overlap = stats.max_overlap.max(s.max_overlap_after_projection);
 }
