@@ -127,7 +127,7 @@ pub enum OrientationSpec {
     Random,
     /// Symmetry axis along this lab vector (normalised).
     Axis([f64; 3]),
-    /// Symmetry axis tilted from vertical by this angle [degrees] about the x axis.
+    /// Symmetry axis tilted from vertical by this angle \[degrees\] about the x axis.
     Tilt(f64),
 }
 
