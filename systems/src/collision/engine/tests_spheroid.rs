@@ -255,6 +255,17 @@ fn settle_discs(d: &mut Discs, domain: &CollisionDomain, steps: usize, h: f64) -
         assert!(ke.is_finite(), "NaN state");
         out.peak_kinetic = out.peak_kinetic.max(ke);
         out.final_kinetic = ke;
+        if d.x.len() >= 500 && out.steps % 100 == 0 {
+            // progress of the long release-tier run
+            eprintln!(
+                "step {} t {:.3} s: KE {ke:.3e} J, events {}, overlap after projection {:.2e}, wall {:.0} s",
+                out.steps,
+                out.steps as f64 * h,
+                out.events,
+                st.max_overlap_after_projection,
+                clock.elapsed().as_secs_f64()
+            );
+        }
     }
     out.seconds = clock.elapsed().as_secs_f64();
     out.lowest = (0..d.x.len())
