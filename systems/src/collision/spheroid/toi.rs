@@ -42,7 +42,9 @@
 //! tests; then `None` is returned).
 //!
 //! A bounding-sphere test (analytic sphere TOI with the bounding radii) skips the time before the
-//! bounding spheres can touch. Spheroid–plane uses the same loop on the closed-form gap.
+//! bounding spheres can touch, and the centre line and both symmetry axes are tried as fixed
+//! separating axes before any contact solve: if one certifies a gap above `δ_hit` for the whole
+//! horizon the pair is dismissed at once (same answer, no Newton iteration). Spheroid–plane uses the same loop on the closed-form gap.
 
 use glam::{DQuat, DVec3};
 
@@ -278,6 +280,25 @@ pub fn spheroid_pair_toi(
         let (bb, ab) = rate_bounds(sb, wb, u);
         (u.dot(dv).abs() + ba + bb, aa + ab)
     };
+    // cheap exit without a contact solve: a fixed separating axis (centre line or a symmetry
+    // axis) that certifies a gap above δ_hit for the whole horizon (the loop could not report
+    // an impact either)
+    let d0 = dx + dv * t0;
+    let toward = |e: DVec3| if e.dot(d0) < 0.0 { -e } else { e };
+    for u in [
+        d0.try_normalize(),
+        Some(toward(axis_at(ea, wa, t0))),
+        Some(toward(axis_at(eb, wb, t0))),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let (f, rate) = fixed(u, t0);
+        let (b, acc) = bounds(u);
+        if f > delta_hit && safe_step(f - delta_hit, rate, b, acc) >= horizon - t0 {
+            return None;
+        }
+    }
     advance(
         t0,
         horizon,
