@@ -268,12 +268,13 @@ pub fn integrate_positions(
     )>,
 ) {
     let dt = cfg.dt;
-    q.par_iter_mut().for_each(|(v, w, mut x, mut o, mut s, mut so)| {
-        s.0 = x.0;
-        so.0 = o.0;
-        x.0 += dt * v.0;
-        o.0 = rotate(o.0, w.0, dt);
-    });
+    q.par_iter_mut()
+        .for_each(|(v, w, mut x, mut o, mut s, mut so)| {
+            s.0 = x.0;
+            so.0 = o.0;
+            x.0 += dt * v.0;
+            o.0 = rotate(o.0, w.0, dt);
+        });
 }
 
 /// Wrap positions into the periodic cell (`Finalize::WriteBack`).
