@@ -30,6 +30,9 @@ use magsep_components::prelude::*;
 const SCENE: &str = include_str!("../../../scenes/flakes_binary_i006.toml");
 /// L of the rig [m].
 const HALF_HEIGHT: f64 = 0.075;
+/// Chart points (x, y).
+type Points = Vec<(f64, f64)>;
+
 /// The thesis's mean experimental delays of 1:2 spheroids (sinking, rising).
 const THESIS_MEAN: (f64, f64) = (-0.07, 0.33);
 
@@ -146,7 +149,7 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
     let (t_sink, t_rise) = (alone[0].levitation[0], alone[1].levitation[0]);
     let mut rows = Vec::new();
     // per rule: (sinking, rising) delay points
-    let mut curves: Vec<(Vec<(f64, f64)>, Vec<(f64, f64)>)> = vec![Default::default(); 2];
+    let mut curves: Vec<(Points, Points)> = vec![Default::default(); 2];
     for ((impact, rule), p) in jobs.iter().zip(&pairs) {
         let (a, b) = (p.levitation[0], p.levitation[1]);
         let (da, db) = (delay(a, t_sink), delay(b, t_rise));
