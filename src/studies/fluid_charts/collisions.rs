@@ -72,7 +72,7 @@ fn run(text: &str) -> Result<RunOut, BenchError> {
 /// The scene text for impact factor `impact`, history rule `rule`, duration `duration`,
 /// keeping only particle group `only` if given (0: PVC-U, 1: POM).
 fn variant(impact: f64, rule: &str, duration: f64, only: Option<usize>) -> String {
-    let mut s = SCENE
+    let s = SCENE
         .replace("duration = 12.0 ", &format!("duration = {duration} "))
         .replace(
             "friction = 0.005",
@@ -82,19 +82,25 @@ fn variant(impact: f64, rule: &str, duration: f64, only: Option<usize>) -> Strin
             "[[0.0751, 0.075, 0.0075]]",
             &format!("[[{}, 0.075, 0.0075]]", 0.075 + impact * 5e-3),
         );
-    if let Some(k) = only {
-        let i0 = s
-            .find("[[particles]]                # sinking")
-            .unwrap_or(0);
-        let i1 = s.find("[[particles]]                # rising").unwrap_or(0);
-        let rec = s.find("[record]").unwrap_or(s.len());
-        s = if k == 0 {
-            format!("{}{}", &s[..i1], &s[rec..])
-        } else {
-            format!("{}{}", &s[..i0], &s[i1..])
-        };
+    match only {
+        Some(k) => only_group(&s, k),
+        None => s,
     }
-    s
+}
+
+/// A binary-collision scene (groups marked `# sinking` and `# rising`, then `[record]`) with
+/// only group `k` kept (0: sinking, 1: rising).
+pub(super) fn only_group(s: &str, k: usize) -> String {
+    let i0 = s
+        .find("[[particles]]                # sinking")
+        .unwrap_or(0);
+    let i1 = s.find("[[particles]]                # rising").unwrap_or(0);
+    let rec = s.find("[record]").unwrap_or(s.len());
+    if k == 0 {
+        format!("{}{}", &s[..i1], &s[rec..])
+    } else {
+        format!("{}{}", &s[..i0], &s[i1..])
+    }
 }
 
 fn delay(pair: Option<f64>, alone: Option<f64>) -> Option<f64> {

@@ -91,7 +91,7 @@ fn run(text: &str) -> Result<RunOut, BenchError> {
 
 /// The scene for impact factor `impact` over `duration`, keeping only group `only` if given.
 fn variant(impact: f64, rule: &str, duration: f64, only: Option<usize>) -> String {
-    let mut s = SCENE
+    let s = SCENE
         .replace("duration = 12.0 ", &format!("duration = {duration} "))
         .replace(
             "friction = 0.05",
@@ -101,19 +101,10 @@ fn variant(impact: f64, rule: &str, duration: f64, only: Option<usize>) -> Strin
             "[[0.0753, 0.075, 0.0075]]",
             &format!("[[{}, 0.075, 0.0075]]", 0.075 + impact * 5e-3),
         );
-    if let Some(k) = only {
-        let i0 = s
-            .find("[[particles]]                # sinking")
-            .unwrap_or(0);
-        let i1 = s.find("[[particles]]                # rising").unwrap_or(0);
-        let rec = s.find("[record]").unwrap_or(s.len());
-        s = if k == 0 {
-            format!("{}{}", &s[..i1], &s[rec..])
-        } else {
-            format!("{}{}", &s[..i0], &s[i1..])
-        };
+    match only {
+        Some(k) => super::collisions::only_group(&s, k),
+        None => s,
     }
-    s
 }
 
 fn delay(pair: Option<f64>, alone: Option<f64>) -> Option<f64> {

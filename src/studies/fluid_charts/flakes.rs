@@ -183,18 +183,6 @@ fn many(w: f64, quick: bool) -> String {
         .replace("duration = 6.0 ", &format!("duration = {duration} "))
 }
 
-fn separation_curve(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
-    let mut sim = super::simulation(text)?;
-    let summary = sim.run(|_| {}).map_err(runtime)?;
-    let curve = sim
-        .app
-        .world
-        .get_resource::<SeparationCurve>()
-        .cloned()
-        .unwrap_or_default();
-    Ok((curve, summary))
-}
-
 /// Write the charts and print a JSON summary.
 ///
 /// # Errors
@@ -222,7 +210,7 @@ pub fn chart_flakes(out: &Path, quick: bool) -> Result<(), BenchError> {
                 },
                 || {
                     ws.par_iter()
-                        .map(|&w| separation_curve(&many(w, quick)))
+                        .map(|&w| super::separation::run_case(&many(w, quick)))
                         .collect::<Result<Vec<_>, _>>()
                 },
             )

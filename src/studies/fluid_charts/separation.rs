@@ -63,7 +63,8 @@ fn reduced(text: &str, quick: bool, small: bool) -> String {
         .replace("duration = 5.0 ", "duration = 2.5 ")
 }
 
-fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
+/// Run a scene to its end: its separation curve and summary.
+pub(super) fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
     let mut sim = super::simulation(text)?;
     let summary = sim.run(|_| {}).map_err(runtime)?;
     let curve = sim
