@@ -15,12 +15,14 @@
 //! * [`systems`], [`spheroid_systems`], [`collide`]: the thin ECS systems of the particle-fluid
 //!   pipeline.
 //! * [`observe`]: the separation error e_m (eq. 2.51).
+//! * [`channel`]: the two-way coupled channel-flow solver and its coupling to the particles.
 //! * [`config`]: the pipeline's configuration resource.
 //! * [`history`]: the Basset history integral: full-memory product integration and the
 //!   window + exponential-tail kernel of van Hinsberg et al. (2011).
 //! * [`stokes_reference`]: the exact velocity of a sphere released in unsteady Stokes flow
 //!   (Basset-Boussinesq-Oseen), by numerical Laplace inversion.
 
+pub mod channel;
 pub mod collide;
 pub mod config;
 pub mod drag;
