@@ -172,6 +172,43 @@ impl ChannelGrid {
             .collect()
     }
 
+    /// Clenshaw-Curtis quadrature weights [m] of the z levels: `Σ_k w_k f(z_k)` is exact for
+    /// polynomials of degree ≤ nz − 1 on `[0, height]` (all weights are positive). Multiplied
+    /// by `dx·dy` they are the node volumes of the discrete integrals (momentum budgets,
+    /// filter normalisation).
+    ///
+    /// ```
+    /// use magsep_systems::fluid::channel::grid::ChannelGrid;
+    /// let g = ChannelGrid::new([4, 4, 9], [1.0, 1.0, 2.0]).unwrap();
+    /// let w = g.z_quadrature_weights();
+    /// let int_z4: f64 = w.iter().enumerate().map(|(k, w)| w * g.z(k).powi(4)).sum();
+    /// assert!((int_z4 - 32.0 / 5.0).abs() < 1e-13);
+    /// ```
+    pub fn z_quadrature_weights(&self) -> Vec<f64> {
+        let n = self.nz - 1;
+        let nf = n as f64;
+        let scale = 0.5 * self.height;
+        let end = if n % 2 == 0 {
+            1.0 / (nf * nf - 1.0)
+        } else {
+            1.0 / (nf * nf)
+        };
+        let mut w = vec![end * scale; self.nz];
+        for (k, wk) in w.iter_mut().enumerate().take(n).skip(1) {
+            let theta = PI * k as f64 / nf;
+            let mut v = 1.0;
+            for m in 1..=(n - 1) / 2 {
+                let mf = m as f64;
+                v -= 2.0 * (2.0 * mf * theta).cos() / (4.0 * mf * mf - 1.0);
+            }
+            if n % 2 == 0 {
+                v -= (nf * theta).cos() / (nf * nf - 1.0);
+            }
+            *wk = 2.0 * v / nf * scale;
+        }
+        w
+    }
+
     /// The level k with `z_k ≤ z < z_{k+1}` (clamped to the channel), for the host cell of a
     /// point; `None` for a non-finite z.
     pub fn level_below(&self, z: f64) -> Option<usize> {
@@ -210,6 +247,16 @@ mod tests {
         assert_eq!(g.level_below(-1.0), Some(0));
         assert_eq!(g.level_below(1.0), Some(g.nz - 2));
         assert_eq!(g.level_below(f64::NAN), None);
+        for nz in [5, 6, 33, 64] {
+            let g = ChannelGrid::new([4, 4, nz], [1.0, 1.0, 0.3]).unwrap();
+            let w = g.z_quadrature_weights();
+            assert!(w.iter().all(|w| *w > 0.0));
+            for p in 0..nz as i32 {
+                let exact = 0.3f64.powi(p + 1) / f64::from(p + 1);
+                let num: f64 = w.iter().enumerate().map(|(k, w)| w * g.z(k).powi(p)).sum();
+                assert!((num - exact).abs() < 1e-13 * exact.max(1e-3), "nz {nz} p {p}");
+            }
+        }
         assert!(ChannelGrid::new([3, 4, 9], [1.0; 3]).is_err());
         assert!(ChannelGrid::new([4, 4, 4], [1.0; 3]).is_err());
         assert!(ChannelGrid::new([4, 4, 9], [1.0, 0.0, 1.0]).is_err());
