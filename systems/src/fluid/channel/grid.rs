@@ -254,7 +254,10 @@ mod tests {
             for p in 0..nz as i32 {
                 let exact = 0.3f64.powi(p + 1) / f64::from(p + 1);
                 let num: f64 = w.iter().enumerate().map(|(k, w)| w * g.z(k).powi(p)).sum();
-                assert!((num - exact).abs() < 1e-13 * exact.max(1e-3), "nz {nz} p {p}");
+                assert!(
+                    (num - exact).abs() < 1e-13 * exact.max(1e-3),
+                    "nz {nz} p {p}"
+                );
             }
         }
         assert!(ChannelGrid::new([3, 4, 9], [1.0; 3]).is_err());
