@@ -62,6 +62,7 @@ fn world() -> SimApp {
         levitation_tolerance: 5e-4,
         observe_every: STEPS,
         spheroids: Default::default(),
+        solver: None,
     });
     app.world
         .insert_resource(FluidDomain(CollisionDomain::unbounded()));

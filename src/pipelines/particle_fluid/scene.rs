@@ -37,6 +37,7 @@
 
 use glam::DVec3;
 use magsep_systems::collision::{CollisionModel, Restitution};
+use magsep_systems::fluid::channel::config::LiquidSolver;
 use magsep_systems::fluid::collide::CollisionHistory;
 use magsep_systems::fluid::config::{
     ForceTerms, HistoryChoice, Integrator, ParticleFluidConfig, STANDARD_GRAVITY, SpheroidOptions,
@@ -99,6 +100,12 @@ pub struct LiquidSection {
     /// Undisturbed flow. Default quiescent.
     #[serde(default)]
     pub flow: FlowModel,
+    /// Solve the liquid (two-way coupling): `{ kind = "channel", grid = [nx, ny, nz],
+    /// coupling = "two_way" | "two_way_force" | "one_way", self_induced_correction = false,
+    /// dealias = true, feedback_lift = true, record_every = N }`. Default: none (the liquid is
+    /// the prescribed `flow`, one-way coupled).
+    #[serde(default)]
+    pub solver: Option<LiquidSolver>,
 }
 
 /// Which magnet arrangement.
@@ -283,6 +290,7 @@ impl ParticleFluidScene {
             levitation_tolerance: s.levitation_tolerance.unwrap_or(0.5e-3),
             observe_every: s.observe_every.unwrap_or((steps / 200).max(1)),
             spheroids: s.spheroids,
+            solver: self.liquid.solver,
         }
     }
 }

@@ -3,6 +3,7 @@
 //! `volume_fraction`.
 
 use glam::DVec3;
+use magsep_systems::fluid::channel::config::LiquidSolver;
 use magsep_systems::fluid::config::HistoryChoice;
 use magsep_systems::fluid::flow::FlowModel;
 
@@ -61,6 +62,25 @@ fn flow_checks(flow: &FlowModel, errors: &mut Vec<SceneError>) {
             );
         }
     }
+}
+
+/// The simulated liquid: its options, a channel container, and no prescribed flow beside it.
+fn solver_checks(pf: &ParticleFluidScene, errors: &mut Vec<SceneError>) {
+    let Some(LiquidSolver::Channel(spec)) = &pf.liquid.solver else {
+        return;
+    };
+    for (key, message) in spec.problems() {
+        errors.push(SceneError::new(format!("liquid.solver.{key}"), message));
+    }
+    check(
+        errors,
+        matches!(pf.container, FluidContainerSpec::Channel { .. }),
+        "liquid.solver.kind",
+        || "a \"channel\" solver needs [container] kind = \"channel\"".into(),
+    );
+    check(errors, pf.liquid.flow.is_quiescent(), "liquid.flow", || {
+        "a prescribed flow cannot be combined with a solved liquid (remove one)".into()
+    });
 }
 
 /// Check the particle-fluid sections; resolve `count` from `volume_fraction`.
@@ -127,6 +147,7 @@ pub fn validate(
         "[Pa s]",
     );
     flow_checks(&pf.liquid.flow, errors);
+    solver_checks(pf, errors);
     let chi = pf.liquid.susceptibility;
     check(
         errors,

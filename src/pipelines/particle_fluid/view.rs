@@ -128,6 +128,7 @@ mod tests {
             levitation_tolerance: 5e-4,
             observe_every: 1,
             spheroids: Default::default(),
+            solver: None,
         };
         let cubes = magnet_backdrop(&cfg, DVec3::splat(0.15));
         assert_eq!(cubes.len(), SLICES + 1); // slices and the bottom face

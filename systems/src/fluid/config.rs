@@ -5,6 +5,7 @@
 use bevy_ecs::prelude::Resource;
 use serde::{Deserialize, Serialize};
 
+use super::channel::config::{ChannelSpec, LiquidSolver};
 use super::drag::DragLaw;
 use super::flow::FlowModel;
 use super::magnet::{Liquid, MagnetModel};
@@ -159,6 +160,9 @@ pub struct ParticleFluidConfig {
     /// How spheroids are modelled.
     #[serde(default)]
     pub spheroids: SpheroidOptions,
+    /// The simulated liquid (two-way coupling), if any.
+    #[serde(default)]
+    pub solver: Option<LiquidSolver>,
 }
 
 impl ParticleFluidConfig {
@@ -179,6 +183,15 @@ impl ParticleFluidConfig {
         self.terms.magnetic_buoyancy
             && !matches!(self.magnet, MagnetModel::None)
             && self.liquid.susceptibility != 0.0
+    }
+
+    /// The channel solver's options when the liquid is solved (a solver whose coupling is
+    /// not one-way).
+    pub fn channel(&self) -> Option<ChannelSpec> {
+        match self.solver {
+            Some(LiquidSolver::Channel(c)) if c.coupling.solves_liquid() => Some(c),
+            _ => None,
+        }
     }
 
     /// Whether a magnetic torque can act (a magnet and a magnetisable liquid).

@@ -28,6 +28,7 @@ fn world(shape: Shape, body: InertialBody, dt: f64) -> World {
         levitation_tolerance: 5e-4,
         observe_every: 1,
         spheroids: Default::default(),
+        solver: None,
     });
     w.insert_resource(StepClock::new(dt));
     w.insert_resource(FluidDomain(CollisionDomain::unbounded()));
