@@ -18,6 +18,7 @@ pub mod app;
 pub mod brownian;
 pub mod core;
 pub mod group;
+pub mod liquid;
 pub mod packing;
 pub mod particle_fluid;
 pub use magsep_record as record;

@@ -46,6 +46,7 @@ use magsep_systems::sets::{ForceSystems, SimSystems};
 use crate::app::{SimApp, SimPlugin};
 use crate::core::{CorePlugin, FinalizeSystems};
 use crate::group::PipelineGroup;
+use crate::liquid::LiquidPlugin;
 use crate::recorder::RecordPlugin;
 
 fn config(app: &SimApp) -> Option<ParticleFluidConfig> {
@@ -232,7 +233,8 @@ impl SimPlugin for SeparationObservePlugin {
     }
 }
 
-/// The particle-fluid pipeline for `cfg`: core, forces, integrator, collisions (if on),
+/// The particle-fluid pipeline for `cfg`: core, forces, integrator, the simulated liquid
+/// (when the scene has one), collisions (if on),
 /// separation error, recording.
 ///
 /// ```
@@ -244,7 +246,8 @@ pub fn particle_fluid_pipeline(collisions: bool) -> PipelineGroup {
     let group = PipelineGroup::new()
         .add(CorePlugin)
         .add(InertialForcesPlugin)
-        .add(InertialIntegratorPlugin);
+        .add(InertialIntegratorPlugin)
+        .add(LiquidPlugin);
     let group = if collisions {
         group.add(CollisionPlugin)
     } else {

@@ -78,6 +78,7 @@
 #![warn(missing_docs)]
 
 pub mod frame;
+pub mod grid;
 mod meta;
 mod parse;
 mod proto;

@@ -11,8 +11,10 @@
 #   PROCS          MPI process counts             (default "1 2")
 #   STEPS          timed steps                    (default 20)
 #   WARMUP         untimed steps before timing    (default 3)
-#   WALL_EXTRA     wall-normal points = N + WALL_EXTRA (default 1, i.e. N+1 Chebyshev points)
+#   WALL_EXTRA     wall-normal Chebyshev points = N + WALL_EXTRA (default 0). Must give an even
+#                  count: shenfun 4.3.0's Chebyshev biharmonic solver returns NaN for an odd one.
 #   DEALIAS        "3/2" (shenfun's default padding (1, 1.5, 1.5)) or "none" (default 3/2)
+#   RUN_TIMEOUT    seconds allowed for one (grid, procs) run (default 1800)
 #   SETUP_ONLY=1   only install, run nothing
 # Output: one JSON line per (grid, procs) on stdout; diagnostics on stderr.
 # Exit 3 when Debian packages are missing and cannot be installed (no root, no sudo -n).
@@ -26,8 +28,9 @@ GRIDS="${GRIDS:-32 64 128}"
 PROCS="${PROCS:-1 2}"
 STEPS="${STEPS:-20}"
 WARMUP="${WARMUP:-3}"
-WALL_EXTRA="${WALL_EXTRA:-1}"
+WALL_EXTRA="${WALL_EXTRA:-0}"
 DEALIAS="${DEALIAS:-3/2}"
+RUN_TIMEOUT="${RUN_TIMEOUT:-1800}"
 
 log() { echo "[shenfun_kmm] $*" >&2; }
 
@@ -65,25 +68,31 @@ fi
 
 # ---- 2. Python venv with shenfun and its dependencies ----
 STAMP="$VENV/.shenfun-peer-$SHENFUN_VERSION"
-if [ ! -e "$STAMP" ]; then
+VPY="$VENV/bin/python"
+IMPORTS='import shenfun, mpi4py, mpi4py_fft, numpy, scipy, sympy, yaml, numba'
+if [ ! -e "$STAMP" ] || ! "$VPY" -c "$IMPORTS" 2>/dev/null; then
     if [ ! -x "$VENV/bin/python" ]; then
         log "creating venv $VENV"
         "$PYTHON" -m venv "$VENV"
     fi
     VPIP=("$VENV/bin/python" -m pip --disable-pip-version-check)
     "${VPIP[@]}" install -q --upgrade pip setuptools wheel cython >&2
-    "${VPIP[@]}" install -q numpy scipy sympy >&2
+    # pyyaml and numba: shenfun 4.3.0 imports both unconditionally (shenfun.config,
+    # shenfun.optimization) but its setup.py does not declare them.
+    # numpy<2.4: with numpy 2.4 shenfun 4.3.0's Cython LU_Helmholtz raises "only 0-dimensional
+    # arrays can be converted to Python scalars" while assembling the KMM solvers.
+    "${VPIP[@]}" install -q "numpy<2.4" scipy sympy pyyaml numba >&2
     # mpi4py built from source against the system MPI (so mpiexec and libmpi match).
     log "building mpi4py against $(command -v mpicc)"
     MPICC="$(command -v mpicc)" "${VPIP[@]}" install -q --no-binary mpi4py mpi4py >&2
     # mpi4py-fft and shenfun are sdists with C/Cython extensions.
     log "building mpi4py-fft and shenfun==$SHENFUN_VERSION"
     "${VPIP[@]}" install -q mpi4py-fft >&2
-    "${VPIP[@]}" install -q "shenfun==$SHENFUN_VERSION" >&2
+    "${VPIP[@]}" install -q "shenfun==$SHENFUN_VERSION" "numpy<2.4" >&2
     touch "$STAMP"
 fi
-VPY="$VENV/bin/python"
-log "versions: $("$VPY" -c 'import shenfun, mpi4py, mpi4py_fft, numpy, scipy, sympy; print("shenfun", shenfun.__version__, "mpi4py", mpi4py.__version__, "mpi4py_fft", mpi4py_fft.__version__, "numpy", numpy.__version__, "scipy", scipy.__version__, "sympy", sympy.__version__)')"
+VERSIONS="$("$VPY" -c "$IMPORTS"'; print("shenfun", shenfun.__version__, "mpi4py", mpi4py.__version__, "mpi4py_fft", mpi4py_fft.__version__, "numpy", numpy.__version__, "scipy", scipy.__version__, "sympy", sympy.__version__)')"
+log "versions: $VERSIONS; MPI: $("$VPY" -c 'from mpi4py import MPI; print(MPI.Get_library_version().splitlines()[0])')"
 
 if [ "${SETUP_ONLY:-0}" = "1" ]; then
     log "SETUP_ONLY=1: done"
@@ -101,7 +110,7 @@ status=0
 for n in $GRIDS; do
     for p in $PROCS; do
         log "N=$n procs=$p steps=$STEPS warmup=$WARMUP dealias=$DEALIAS"
-        if ! (cd "$RUNDIR" && "$MPIEXEC" -n "$p" "$VPY" "$HERE/shenfun/kmm_bench.py" \
+        if ! (cd "$RUNDIR" && timeout "$RUN_TIMEOUT" "$MPIEXEC" -n "$p" "$VPY" "$HERE/shenfun/kmm_bench.py" \
                 --n "$n" --wall-extra "$WALL_EXTRA" --steps "$STEPS" --warmup "$WARMUP" \
                 --dealias "$DEALIAS"); then
             log "run N=$n procs=$p failed"

@@ -205,6 +205,8 @@ pub enum BenchKind {
     Brownian,
     /// The history force and the particle-fluid pipeline.
     ParticleFluid,
+    /// The channel-flow solver of the coupled liquid and the coupling per particle.
+    Fluid,
 }
 
 /// The charts of `magsep chart`.
@@ -240,6 +242,8 @@ pub enum ChartKind {
     FlakeCollisions,
     /// Models of the 1:10 spheroid's drag, lift and torque: error against cost.
     SpheroidModel,
+    /// The two-way coupled liquid: settling against the grid, separation one-way against two-way.
+    Coupling,
 }
 
 /// `magsep bench KIND [--json] [--quick]`.
@@ -255,6 +259,7 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         BenchKind::ParticleFluid => {
             return crate::studies::fluid_charts::bench_particle_fluid(as_json, quick);
         }
+        BenchKind::Fluid => return crate::studies::liquid::bench::bench_fluid(as_json, quick),
         BenchKind::Packing => {}
     }
     let threads = rayon::current_num_threads();
@@ -360,6 +365,7 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         ChartKind::Separation => return fc::chart_separation(out, quick),
         ChartKind::Flakes => return fc::chart_flakes(out, quick),
         ChartKind::FlakeCollisions => return fc::chart_flake_collisions(out, quick),
+        ChartKind::Coupling => return crate::studies::liquid::chart::chart_coupling(out, quick),
         ChartKind::SpheroidModel => return fc::chart_spheroid_model(out, quick),
         ChartKind::SqContact => {
             std::fs::create_dir_all(out)

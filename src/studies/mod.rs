@@ -8,5 +8,6 @@ pub mod bench_field;
 pub mod brownian_chart;
 pub mod brownian_sweep;
 pub mod fluid_charts;
+pub mod liquid;
 pub mod packing_charts;
 pub mod sq_study;

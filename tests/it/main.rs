@@ -14,6 +14,7 @@ mod common;
 mod field_reference;
 mod fluid_charts;
 mod graceful_stop;
+mod liquid;
 mod memory_budget;
 mod outputs;
 mod packing_validation;

@@ -5,6 +5,8 @@
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
+use magsep_systems::fluid::channel::grid::ChannelGrid;
+use magsep_systems::fluid::channel::systems::ChannelLiquid;
 use magsep_systems::collision::{CollisionDomain, Plane};
 use magsep_systems::fluid::collide::CollisionWorkspace;
 use magsep_systems::fluid::config::ParticleFluidConfig;
@@ -335,6 +337,14 @@ pub fn spawn_particle_fluid(
             pf.collisions.model(&pf.liquid),
             pf.collisions.history.unwrap_or_default(),
         ));
+    }
+    if let Some(spec) = cfg.channel() {
+        let grid = ChannelGrid::new(spec.grid, edges.to_array())
+            .map_err(|e| SpawnError::Other(format!("liquid.solver.grid: {e}")))?;
+        let nu = cfg.liquid.viscosity / cfg.liquid.density;
+        let liquid = ChannelLiquid::new(spec, grid, nu, cfg.dt)
+            .map_err(|e| SpawnError::Other(format!("liquid.solver: {e}")))?;
+        world.insert_resource(liquid);
     }
     world.insert_resource(StepClock::new(cfg.dt));
     world.insert_resource(cfg);

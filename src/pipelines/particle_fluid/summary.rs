@@ -3,6 +3,7 @@
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
+use magsep_systems::fluid::channel::systems::ChannelLiquid;
 use magsep_systems::fluid::config::{HistoryChoice, Integrator, ParticleFluidConfig};
 use magsep_systems::fluid::observe::{SeparationCurve, separation_scale};
 use serde_json::{Value, json};
@@ -162,6 +163,7 @@ pub fn run_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
         "drag_law": cfg.drag_law,
         "history": if cfg.terms.history { history } else { Value::Null },
         "liquid": cfg.liquid,
+        "liquid_solver": liquid_json(world, cfg),
         "magnet": cfg.magnet,
         "mid_plane": cfg.mid_plane,
         "sorting_range": cfg.magnet.sorting_range(&cfg.liquid, cfg.gravity),
@@ -175,6 +177,32 @@ pub fn run_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
         "warnings": warnings,
         "wall_time_s": wall_time_s,
         "particle_steps_per_s": if wall_time_s > 0.0 { (n as f64 * steps as f64) / wall_time_s } else { 0.0 },
+    })
+}
+
+/// The simulated liquid: options, grid, final state (`null` without one).
+fn liquid_json(world: &World, cfg: &ParticleFluidConfig) -> Value {
+    let Some(solver) = cfg.solver else {
+        return Value::Null;
+    };
+    let Some(l) = world.get_resource::<ChannelLiquid>() else {
+        // one-way: the liquid stays at rest and is not solved
+        return json!({ "options": solver, "solved": false });
+    };
+    let u = l.solver.velocity();
+    let max_speed = (0..u[0].len())
+        .map(|n| (u[0][n] * u[0][n] + u[1][n] * u[1][n] + u[2][n] * u[2][n]).sqrt())
+        .fold(0.0, f64::max);
+    json!({
+        "options": solver,
+        "solved": true,
+        "time": l.solver.time(),
+        "steps": l.solver.steps(),
+        "max_speed": finite(max_speed),
+        "max_divergence": finite(l.solver.divergence_max()),
+        "cfl": finite(l.solver.cfl()),
+        "mean_velocity": l.solver.mean_velocity().to_array().map(finite),
+        "last_feedback_force": l.last_feedback.to_array().map(finite),
     })
 }
 

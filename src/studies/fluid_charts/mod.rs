@@ -19,7 +19,7 @@ mod flake_collisions;
 mod flakes;
 mod history;
 mod levitation;
-mod separation;
+pub(crate) mod separation;
 mod spheroid_model;
 
 pub use bench::bench_particle_fluid;

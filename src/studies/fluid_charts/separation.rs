@@ -64,7 +64,7 @@ fn reduced(text: &str, quick: bool, small: bool) -> String {
 }
 
 /// Run a scene to its end: its separation curve and summary.
-pub(super) fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
+pub(crate) fn run_case(text: &str) -> Result<(SeparationCurve, Value), BenchError> {
     let mut sim = super::simulation(text)?;
     let summary = sim.run(|_| {}).map_err(runtime)?;
     let curve = sim

@@ -199,9 +199,10 @@ impl ParticleFluidConfig {
         !matches!(self.magnet, MagnetModel::None) && self.liquid.susceptibility != 0.0
     }
 
-    /// Whether the undisturbed-flow force runs (a non-quiescent flow).
+    /// Whether the undisturbed-flow force runs (a non-quiescent flow or a solved liquid).
     pub fn undisturbed_on(&self) -> bool {
-        (self.terms.undisturbed_flow || self.terms.added_mass) && !self.flow.is_quiescent()
+        (self.terms.undisturbed_flow || self.terms.added_mass)
+            && (!self.flow.is_quiescent() || self.channel().is_some())
     }
 
     /// The terms that run, by name, in a stable order (for the summary).
