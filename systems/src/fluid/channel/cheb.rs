@@ -50,7 +50,7 @@ fn xi_levels(nz: usize) -> Vec<f64> {
         .collect()
 }
 
-/// First-derivative collocation matrix on the levels of `grid` [1/m] (row-major `nz × nz`).
+/// First-derivative collocation matrix on the levels of `grid` \[1/m\] (row-major `nz × nz`).
 ///
 /// Off-diagonal entries from the barycentric formula, diagonal entries by the negative-sum
 /// trick (exact derivative of constants).
@@ -89,7 +89,7 @@ pub(crate) fn matmul(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
     c
 }
 
-/// Clenshaw-Curtis quadrature weights [m] at the levels of `grid`: `Σ_k w_k f(z_k)` integrates
+/// Clenshaw-Curtis quadrature weights \[m\] at the levels of `grid`: `Σ_k w_k f(z_k)` integrates
 /// polynomials of degree ≤ `nz − 1` over `0 ≤ z ≤ height` exactly (up to rounding).
 ///
 /// ```
@@ -145,7 +145,7 @@ pub struct HelmholtzDiag {
     p: Vec<f64>,
     /// Their inverse (row-major `m × m`).
     pinv: Vec<f64>,
-    /// Eigenvalues of `D2_II` [1/m²] (negative).
+    /// Eigenvalues of `D2_II` \[1/m²\] (negative).
     lam: Vec<f64>,
     /// Column of D2 at the bottom wall, interior rows.
     col0: Vec<f64>,
@@ -222,7 +222,7 @@ impl HelmholtzDiag {
         self.m
     }
 
-    /// Eigenvalues of the interior second-derivative block [1/m²].
+    /// Eigenvalues of the interior second-derivative block \[1/m²\].
     pub fn eigenvalues(&self) -> &[f64] {
         &self.lam
     }

@@ -4,8 +4,8 @@
 //! # Method
 //!
 //! The liquid is incompressible, `∂u/∂t = u × ω − ∇P + ν ∇²u + f + G`, with `ω = ∇ × u`, the
-//! reduced pressure `P = p/ρ + |u|²/2`, the body force per unit mass `f` [m/s²] supplied by
-//! the caller and an imposed mean pressure gradient `G` [m/s²] along x and y. In the
+//! reduced pressure `P = p/ρ + |u|²/2`, the body force per unit mass `f` \[m/s²\] supplied by
+//! the caller and an imposed mean pressure gradient `G` \[m/s²\] along x and y. In the
 //! quasi-equilibrium ferrohydrodynamic model the magnetic body force `μ₀ M ∇H / ρ` of the
 //! magnetised liquid is a gradient and is absorbed into `P`; the solver needs nothing extra
 //! for it (a gradient force produces no velocity, see the tests).
@@ -58,19 +58,19 @@ pub(crate) const ZETA: [f64; 3] = [0.0, -17.0 / 60.0, -5.0 / 12.0];
 
 const ZERO: C = C::new(0.0, 0.0);
 
-/// Parameters of a [`ChannelSolver`].
+/// Parameters of a [`ChannelSolver`](super::stepper::ChannelSolver).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChannelParams {
     /// The collocation grid.
     pub grid: ChannelGrid,
-    /// Kinematic viscosity ν [m²/s].
+    /// Kinematic viscosity ν \[m²/s\].
     pub viscosity: f64,
-    /// Time step [s].
+    /// Time step \[s\].
     pub dt: f64,
     /// Evaluate the nonlinear term on a 3/2-padded grid (true, default) or on the collocation
     /// grid (aliased).
     pub dealias: bool,
-    /// Imposed mean pressure gradient per unit mass, `−(1/ρ) ∂p/∂x`, `−(1/ρ) ∂p/∂y` [m/s²].
+    /// Imposed mean pressure gradient per unit mass, `−(1/ρ) ∂p/∂x`, `−(1/ρ) ∂p/∂y` \[m/s²\].
     pub mean_pressure_gradient: [f64; 2],
 }
 
@@ -149,14 +149,14 @@ pub enum ChannelError {
 #[derive(Debug)]
 pub(crate) struct Ops {
     pub(crate) nz: usize,
-    /// First-derivative matrix [1/m].
+    /// First-derivative matrix \[1/m\].
     pub(crate) d: Vec<f64>,
-    /// Second-derivative matrix [1/m²].
+    /// Second-derivative matrix \[1/m²\].
     pub(crate) d2: Vec<f64>,
     pub(crate) helm: HelmholtzDiag,
-    /// kx per spectral row [1/m].
+    /// kx per spectral row \[1/m\].
     pub(crate) kx: Vec<f64>,
-    /// ky per spectral column [1/m].
+    /// ky per spectral column \[1/m\].
     pub(crate) ky: Vec<f64>,
     pub(crate) nyh: usize,
     pub(crate) nx: usize,

@@ -16,7 +16,7 @@ pub const STATE_VERSION: u32 = 1;
 const HEADER: usize = 8 + 4 + 6 * 8 + 3 * 8 + 8;
 
 impl ChannelSolver {
-    /// Sets the velocity from physical values at the nodes [m/s], keeping only the
+    /// Sets the velocity from physical values at the nodes \[m/s\], keeping only the
     /// divergence-free part that satisfies the wall conditions: per Fourier mode the z-velocity
     /// and the z-vorticity of the input are kept, the z-velocity's wall values and wall slopes
     /// are removed by cubic Hermite polynomials in z, the vorticity's wall values are set to
@@ -95,7 +95,7 @@ impl ChannelSolver {
         Ok(())
     }
 
-    /// Maximum of `|∇·u|` over the nodes [1/s], from the physical velocity differentiated
+    /// Maximum of `|∇·u|` over the nodes \[1/s\], from the physical velocity differentiated
     /// spectrally (Fourier in x, y; Chebyshev in z).
     pub fn divergence_max(&self) -> f64 {
         let vel = self.velocity();
@@ -120,7 +120,7 @@ impl ChannelSolver {
         out[0].iter().fold(0.0, |a, v| a.max(v.abs()))
     }
 
-    /// Volume-averaged velocity [m/s] (uniform weights in x, y; Clenshaw-Curtis in z).
+    /// Volume-averaged velocity \[m/s\] (uniform weights in x, y; Clenshaw-Curtis in z).
     pub fn mean_velocity(&self) -> DVec3 {
         let g = self.grid();
         let w = clenshaw_curtis_weights(g);
@@ -136,7 +136,7 @@ impl ChannelSolver {
         out
     }
 
-    /// Wall shear stress per unit density of the mean flow [m²/s²]: `ν ∂(U, V)/∂z` at the
+    /// Wall shear stress per unit density of the mean flow \[m²/s²\]: `ν ∂(U, V)/∂z` at the
     /// bottom wall (index 0) and the top wall (index 1).
     pub fn wall_shear(&self) -> [[f64; 2]; 2] {
         let nz = self.grid().nz;
@@ -156,7 +156,7 @@ impl ChannelSolver {
         ]
     }
 
-    /// The mean velocity profiles U(z), V(z) [m/s] at the levels.
+    /// The mean velocity profiles U(z), V(z) \[m/s\] at the levels.
     pub fn mean_profiles(&self) -> [&[f64]; 2] {
         [&self.um[0], &self.um[1]]
     }

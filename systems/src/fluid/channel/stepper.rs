@@ -19,11 +19,11 @@ pub struct ChannelSolver {
     /// Transforms on the (possibly) padded grid of the nonlinear term.
     pub(crate) fft_pad: PlaneFft,
     pub(crate) nmodes: usize,
-    /// z-velocity per mode (mode-major, `nz` levels each) [m/s].
+    /// z-velocity per mode (mode-major, `nz` levels each) \[m/s\].
     pub(crate) w: Vec<C>,
-    /// z-vorticity per mode [1/s].
+    /// z-vorticity per mode \[1/s\].
     pub(crate) eta: Vec<C>,
-    /// Mean velocities U(z), V(z) [m/s].
+    /// Mean velocities U(z), V(z) \[m/s\].
     pub(crate) um: [Vec<f64>; 2],
     hw_prev: Vec<C>,
     heta_prev: Vec<C>,
@@ -119,7 +119,7 @@ impl ChannelSolver {
         &self.params.grid
     }
 
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub fn time(&self) -> f64 {
         self.time
     }
@@ -129,24 +129,24 @@ impl ChannelSolver {
         self.steps
     }
 
-    /// Body force per unit mass [m/s²] at the nodes (x, y, z components), held constant over
+    /// Body force per unit mass \[m/s²\] at the nodes (x, y, z components), held constant over
     /// the next step; the caller overwrites it before each step. Zero initially.
     pub fn body_force_mut(&mut self) -> [&mut [f64]; 3] {
         let [a, b, c] = &mut self.force;
         [a, b, c]
     }
 
-    /// Velocity [m/s] at the nodes after the last step (x, y, z components).
+    /// Velocity \[m/s\] at the nodes after the last step (x, y, z components).
     pub fn velocity(&self) -> [&[f64]; 3] {
         [&self.vel[0], &self.vel[1], &self.vel[2]]
     }
 
-    /// Vorticity `∇ × u` [1/s] at the nodes after the last step.
+    /// Vorticity `∇ × u` \[1/s\] at the nodes after the last step.
     pub fn vorticity(&self) -> [&[f64]; 3] {
         [&self.vort[0], &self.vort[1], &self.vort[2]]
     }
 
-    /// Mode-major spectral amplitudes `[m][f][k]` of `nf` physical fields.
+    /// Mode-major spectral amplitudes `\[m\]\[f\]\[k\]` of `nf` physical fields.
     pub(crate) fn to_modes(&self, fields: &[&[f64]]) -> Vec<C> {
         let nf = fields.len();
         let (nz, nm) = (self.ops.nz, self.nmodes);
@@ -176,7 +176,7 @@ impl ChannelSolver {
         modes
     }
 
-    /// Physical fields from mode-major amplitudes `[m][f][k]` of `out.len()` fields.
+    /// Physical fields from mode-major amplitudes `\[m\]\[f\]\[k\]` of `out.len()` fields.
     pub(crate) fn to_phys(&self, modes: &[C], out: &mut [Vec<f64>]) {
         let nf = out.len();
         let nz = self.ops.nz;
@@ -203,7 +203,7 @@ impl ChannelSolver {
         }
     }
 
-    /// Spectral velocity and vorticity `[m][u, v, w, ωx, ωy, ωz][k]` of the current state.
+    /// Spectral velocity and vorticity `\[m\][u, v, w, ωx, ωy, ωz]\[k\]` of the current state.
     pub(crate) fn fields(&self) -> Vec<C> {
         let nz = self.ops.nz;
         let ops = &self.ops;
@@ -253,7 +253,7 @@ impl ChannelSolver {
         out
     }
 
-    /// Plane-major spectral `H = u × ω` `[k][x, y, z][m]` of the current state.
+    /// Plane-major spectral `H = u × ω` `\[k\][x, y, z]\[m\]` of the current state.
     fn nonlinear(&self) -> Vec<C> {
         let (nz, nm) = (self.ops.nz, self.nmodes);
         let fields = self.fields();
