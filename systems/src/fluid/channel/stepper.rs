@@ -146,7 +146,7 @@ impl ChannelSolver {
         [&self.vort[0], &self.vort[1], &self.vort[2]]
     }
 
-    /// Mode-major spectral amplitudes `\[m\]\[f\]\[k\]` of `nf` physical fields.
+    /// Mode-major spectral amplitudes `[m][f][k]` of `nf` physical fields.
     pub(crate) fn to_modes(&self, fields: &[&[f64]]) -> Vec<C> {
         let nf = fields.len();
         let (nz, nm) = (self.ops.nz, self.nmodes);
@@ -176,7 +176,7 @@ impl ChannelSolver {
         modes
     }
 
-    /// Physical fields from mode-major amplitudes `\[m\]\[f\]\[k\]` of `out.len()` fields.
+    /// Physical fields from mode-major amplitudes `[m][f][k]` of `out.len()` fields.
     pub(crate) fn to_phys(&self, modes: &[C], out: &mut [Vec<f64>]) {
         let nf = out.len();
         let nz = self.ops.nz;
@@ -203,7 +203,7 @@ impl ChannelSolver {
         }
     }
 
-    /// Spectral velocity and vorticity `\[m\][u, v, w, ωx, ωy, ωz]\[k\]` of the current state.
+    /// Spectral velocity and vorticity `[m][u, v, w, ωx, ωy, ωz][k]` of the current state.
     pub(crate) fn fields(&self) -> Vec<C> {
         let nz = self.ops.nz;
         let ops = &self.ops;
@@ -253,7 +253,7 @@ impl ChannelSolver {
         out
     }
 
-    /// Plane-major spectral `H = u × ω` `\[k\][x, y, z]\[m\]` of the current state.
+    /// Plane-major spectral `H = u × ω` `[k][x, y, z][m]` of the current state.
     fn nonlinear(&self) -> Vec<C> {
         let (nz, nm) = (self.ops.nz, self.nmodes);
         let fields = self.fields();
