@@ -35,8 +35,8 @@ pub enum GridError {
     TooLarge([usize; 3]),
 }
 
-/// Channel grid: `nx × ny` periodic points over `lx × ly` [m], `nz` Chebyshev-Gauss-Lobatto
-/// points over `0 ≤ z ≤ height` [m].
+/// Channel grid: `nx × ny` periodic points over `lx × ly` \[m\], `nz` Chebyshev-Gauss-Lobatto
+/// points over `0 ≤ z ≤ height` \[m\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChannelGrid {
     /// Points along x (periodic, even).
@@ -45,11 +45,11 @@ pub struct ChannelGrid {
     pub ny: usize,
     /// Chebyshev-Gauss-Lobatto points along z (walls included).
     pub nz: usize,
-    /// Period along x [m].
+    /// Period along x \[m\].
     pub lx: f64,
-    /// Period along y [m].
+    /// Period along y \[m\].
     pub ly: f64,
-    /// Distance between the walls [m].
+    /// Distance between the walls \[m\].
     pub height: f64,
 }
 
@@ -108,27 +108,27 @@ impl ChannelGrid {
         (k * self.nx + i) * self.ny + j
     }
 
-    /// Spacing along x [m].
+    /// Spacing along x \[m\].
     pub fn dx(&self) -> f64 {
         self.lx / self.nx as f64
     }
 
-    /// Spacing along y [m].
+    /// Spacing along y \[m\].
     pub fn dy(&self) -> f64 {
         self.ly / self.ny as f64
     }
 
-    /// x of column i [m].
+    /// x of column i \[m\].
     pub fn x(&self, i: usize) -> f64 {
         i as f64 * self.dx()
     }
 
-    /// y of row j [m].
+    /// y of row j \[m\].
     pub fn y(&self, j: usize) -> f64 {
         j as f64 * self.dy()
     }
 
-    /// z of level k [m] (Chebyshev-Gauss-Lobatto, ascending; exact 0 and `height` at the walls).
+    /// z of level k \[m\] (Chebyshev-Gauss-Lobatto, ascending; exact 0 and `height` at the walls).
     pub fn z(&self, k: usize) -> f64 {
         let n = self.nz - 1;
         if k == 0 {
@@ -140,17 +140,17 @@ impl ChannelGrid {
         0.5 * self.height * (1.0 - (PI * k as f64 / n as f64).cos())
     }
 
-    /// All z levels [m].
+    /// All z levels \[m\].
     pub fn z_levels(&self) -> Vec<f64> {
         (0..self.nz).map(|k| self.z(k)).collect()
     }
 
-    /// Node position [m].
+    /// Node position \[m\].
     pub fn node(&self, i: usize, j: usize, k: usize) -> DVec3 {
         DVec3::new(self.x(i), self.y(j), self.z(k))
     }
 
-    /// Wall-normal control-volume widths [m]: each level owns the half-gaps to its neighbours
+    /// Wall-normal control-volume widths \[m\]: each level owns the half-gaps to its neighbours
     /// (half a gap at the walls); they sum to `height` exactly up to rounding.
     pub fn z_widths(&self) -> Vec<f64> {
         let z = self.z_levels();

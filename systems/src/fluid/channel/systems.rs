@@ -26,7 +26,7 @@ use super::config::ChannelSpec;
 use super::coupling::{FilterStencil, bounding_half_widths, spread_couple, torque_couple};
 use super::grid::ChannelGrid;
 use super::self_induced::self_mobility;
-use super::solver::ChannelSolver;
+use super::stepper::ChannelSolver;
 use crate::fluid::config::{Integrator, ParticleFluidConfig};
 use crate::fluid::spheroid_systems::SpheroidFluid;
 use crate::fluid::systems::StepStart;
