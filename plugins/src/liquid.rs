@@ -65,7 +65,9 @@ impl SimPlugin for LiquidPlugin {
             advance_liquid
                 .after(integrate_positions)
                 .in_set(SimSystems::Integrate),
-            record_liquid.in_set(SimSystems::Record),
+            record_liquid
+                .after(crate::recorder::record_frame)
+                .in_set(SimSystems::Record),
         ));
     }
 }

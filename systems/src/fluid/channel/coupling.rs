@@ -3,9 +3,11 @@
 //!
 //! * **Filter** ([`FilterStencil`]): the top-hat of eq. (4.21). Its box is the particle's
 //!   axis-aligned bounding box (orientation-adaptive for spheroids: half-widths
-//!   `h_k = sqrt(Σ_j R_kj² s_j²)`, [`bounding_half_widths`]), widened per axis to the local grid
-//!   spacing when the particle is smaller than a cell, so that it always covers a node. Its
-//!   weights are normalised discretely with the solver's own node volumes
+//!   `h_k = sqrt(Σ_j R_kj² s_j²)`, [`bounding_half_widths`]). The box is projected onto the grid's
+//!   hat functions (the thesis's "nodes inside the box" would make the filter's width jump
+//!   with the particle's position relative to the nodes, by a factor of up to 3 in volume when
+//!   the box is two cells wide; the projection keeps its volume and centroid). The weights are normalised discretely
+//!   with the solver's own node volumes
 //!   (`dx·dy·w_k`, Clenshaw-Curtis in z) so that `Σ P ΔV = 1` exactly: the force the fluid
 //!   receives integrates to the sum of the particle forces to round-off (spec M6). Wall nodes
 //!   never receive force (the collocation solver overwrites wall rows with the boundary
@@ -49,93 +51,119 @@ pub fn bounding_half_widths(equatorial: f64, polar: f64, q: DQuat) -> DVec3 {
     DVec3::new(row(0), row(1), row(2))
 }
 
-/// The grid nodes of one particle's filter box, with the weight `P` [1/m³] of each (the same
-/// for every node, `Σ P ΔV = 1`).
+/// The grid nodes of one particle's filter box with their weights.
+///
+/// The box is projected onto the piecewise-linear (hat) functions of the grid: a node's weight
+/// is `∫ box φ_n / ∫ φ_n`. This keeps the box's volume and, along the periodic axes, its
+/// centroid exactly wherever the particle sits relative to the nodes (the hats reproduce
+/// linear functions), so the filter moves smoothly with the particle; a box smaller than a
+/// cell spreads like a cloud-in-cell kernel. The weights are then scaled so that
+/// `Σ P ΔV = 1` with the solver's node volumes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FilterStencil {
     /// Flat node indices (see [`ChannelGrid::index`]).
     pub nodes: Vec<usize>,
-    /// Node volumes ΔV [m³] in the order of `nodes`.
-    pub volumes: Vec<f64>,
-    /// The filter value P [1/m³] at every node of the box.
-    pub weight: f64,
+    /// `P_n ΔV_n` per node (they sum to 1): the weights of the filter average.
+    pub weights: Vec<f64>,
+    /// `P_n` [1/m³] per node: the force density per unit force.
+    pub densities: Vec<f64>,
 }
 
-/// Indices of the periodic nodes within `half` of `centre` along an axis with `n` nodes of
-/// spacing `d` (the nearest node when none is): wrapped indices.
-fn periodic_span(centre: f64, half: f64, n: usize, d: f64) -> Vec<usize> {
-    let s = centre / d;
-    let lo = (s - half / d).floor() as i64;
-    let hi = (s + half / d).ceil() as i64;
-    let mut out: Vec<usize> = (lo..=hi)
-        .filter(|m| ((*m as f64) * d - centre).abs() < half)
-        .map(|m| m.rem_euclid(n as i64) as usize)
-        .collect();
-    out.truncate(n);
-    if out.is_empty() {
-        out.push((s.round() as i64).rem_euclid(n as i64) as usize);
+/// `∫_lo^hi φ(x) dx` of the hat φ rising from 0 at `a` to 1 at `b` and falling to 0 at `c`.
+fn hat_integral(lo: f64, hi: f64, a: f64, b: f64, c: f64) -> f64 {
+    let mut sum = 0.0;
+    let (p, q) = (lo.max(a), hi.min(b));
+    if p < q {
+        sum += ((q - a).powi(2) - (p - a).powi(2)) / (2.0 * (b - a));
+    }
+    let (p, q) = (lo.max(b), hi.min(c));
+    if p < q {
+        sum += ((c - p).powi(2) - (c - q).powi(2)) / (2.0 * (c - b));
+    }
+    sum
+}
+
+/// Hat weights `∫ box φ_i / ∫ φ_i` of the periodic nodes overlapping `[c − h, c + h]`:
+/// (wrapped index, weight in [0, 1]).
+fn periodic_weights(centre: f64, half: f64, n: usize, d: f64) -> Vec<(usize, f64)> {
+    let (lo, hi) = (centre - half, centre + half);
+    let first = (lo / d).floor() as i64;
+    let last = (hi / d).ceil() as i64;
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for m in first..=last {
+        let x = m as f64 * d;
+        let f = hat_integral(lo, hi, x - d, x, x + d) / d;
+        if f > 0.0 {
+            let i = m.rem_euclid(n as i64) as usize;
+            match out.iter_mut().find(|(j, _)| *j == i) {
+                Some(slot) => slot.1 += f, // a box wider than the period wraps onto itself
+                None => out.push((i, f)),
+            }
+        }
     }
     out
 }
 
-/// Interior z levels (1 ..= nz − 2) within `half` of `z` (the nearest interior level when
-/// none is).
-fn interior_levels(grid: &ChannelGrid, z: f64, half: f64) -> Vec<usize> {
-    let mut out: Vec<usize> = (1..grid.nz - 1)
-        .filter(|k| (grid.z(*k) - z).abs() < half)
-        .collect();
-    if out.is_empty() {
-        let k = (1..grid.nz - 1)
-            .min_by(|a, b| {
-                let da = (grid.z(*a) - z).abs();
-                let db = (grid.z(*b) - z).abs();
-                da.total_cmp(&db)
-            })
-            .unwrap_or(1);
-        out.push(k);
-    }
-    out
+/// Hat weights of the interior levels overlapping `[z − h, z + h]`.
+fn level_weights(grid: &ChannelGrid, z: f64, half: f64) -> Vec<(usize, f64)> {
+    let (lo, hi) = (z - half, z + half);
+    (1..grid.nz - 1)
+        .filter_map(|k| {
+            let (a, b, c) = (grid.z(k - 1), grid.z(k), grid.z(k + 1));
+            let f = hat_integral(lo, hi, a, b, c) / (0.5 * (c - a));
+            (f > 0.0).then_some((k, f))
+        })
+        .collect()
 }
 
 impl FilterStencil {
     /// The stencil of a box of half-widths `half` [m] centred at `centre` [m] (x and y are
-    /// wrapped; z is clipped to the interior). `zw` are the grid's
-    /// [`ChannelGrid::z_quadrature_weights`]. `None` for a non-finite centre or box.
+    /// wrapped; along z only interior levels take part, a box reaching past them is clipped,
+    /// and a box outside the interior falls back to the nearest interior level). `zw` are the
+    /// grid's [`ChannelGrid::z_quadrature_weights`]. `None` for a non-finite centre or box.
     pub fn new(grid: &ChannelGrid, zw: &[f64], centre: DVec3, half: DVec3) -> Option<Self> {
         if !(centre.is_finite() && half.is_finite()) {
             return None;
         }
         let (dx, dy) = (grid.dx(), grid.dy());
-        let xs = periodic_span(centre.x, half.x.max(0.0), grid.nx, dx);
-        let ys = periodic_span(centre.y, half.y.max(0.0), grid.ny, dy);
-        let zs = interior_levels(grid, centre.z, half.z.max(0.0));
-        let mut nodes = Vec::with_capacity(xs.len() * ys.len() * zs.len());
-        let mut volumes = Vec::with_capacity(nodes.capacity());
-        for &k in &zs {
-            for &i in &xs {
-                for &j in &ys {
+        let half = half.max(DVec3::splat(1e-12 * dx.min(dy)));
+        let xs = periodic_weights(centre.x, half.x, grid.nx, dx);
+        let ys = periodic_weights(centre.y, half.y, grid.ny, dy);
+        let mut zs = level_weights(grid, centre.z, half.z);
+        if zs.is_empty() {
+            let k = grid.level_below(centre.z)?.clamp(1, grid.nz - 2);
+            zs.push((k, 1.0));
+        }
+        let n = xs.len() * ys.len() * zs.len();
+        let mut nodes = Vec::with_capacity(n);
+        let mut raw = Vec::with_capacity(n);
+        let mut volumes = Vec::with_capacity(n);
+        for &(k, fz) in &zs {
+            for &(i, fx) in &xs {
+                for &(j, fy) in &ys {
                     nodes.push(grid.index(i, j, k));
+                    raw.push(fx * fy * fz);
                     volumes.push(dx * dy * zw[k]);
                 }
             }
         }
-        let total: f64 = volumes.iter().sum();
+        let total: f64 = raw.iter().zip(&volumes).map(|(r, v)| r * v).sum();
+        let densities: Vec<f64> = raw.iter().map(|r| r / total).collect();
+        let weights = densities.iter().zip(&volumes).map(|(p, v)| p * v).collect();
         Some(Self {
             nodes,
-            volumes,
-            weight: 1.0 / total,
+            weights,
+            densities,
         })
     }
 
     /// The filter average of a nodal field (`Σ P f ΔV`).
     pub fn average(&self, field: &[f64]) -> f64 {
-        let s: f64 = self
-            .nodes
+        self.nodes
             .iter()
-            .zip(&self.volumes)
-            .map(|(n, v)| field[*n] * v)
-            .sum();
-        s * self.weight
+            .zip(&self.weights)
+            .map(|(n, w)| field[*n] * w)
+            .sum()
     }
 
     /// The filter average of a vector field given as three nodal components.
@@ -149,11 +177,11 @@ impl FilterStencil {
 
     /// Add the force density `P·force/ρ_f` [m/s²] of `force` [N] to the body-force fields.
     pub fn spread(&self, force: DVec3, fluid_density: f64, out: &mut [&mut [f64]; 3]) {
-        let a = force * (self.weight / fluid_density);
-        for n in &self.nodes {
-            out[0][*n] += a.x;
-            out[1][*n] += a.y;
-            out[2][*n] += a.z;
+        let a = force / fluid_density;
+        for (n, p) in self.nodes.iter().zip(&self.densities) {
+            out[0][*n] += a.x * p;
+            out[1][*n] += a.y * p;
+            out[2][*n] += a.z * p;
         }
     }
 }

@@ -90,6 +90,8 @@ pub struct LiquidCoupling {
     pub half_widths: DVec3,
     /// Diagonal self-mobility of the filter [m/(N s)] (for the self-induced correction).
     pub mobility: DVec3,
+    /// The z level the mobility was computed at (it depends on the local spacing).
+    pub mobility_level: Option<usize>,
     /// Velocity at the start of the step [m/s].
     pub step_start_velocity: DVec3,
     /// Angular velocity at the start of the step [rad/s].
@@ -108,13 +110,15 @@ fn half_widths(body: &InertialBody, spheroid: Option<&SpheroidFluid>, o: &Orient
     }
 }
 
-/// The filter half-widths actually used [m]: the bounding box, widened to half the local grid
-/// spacing (a particle smaller than a cell is spread over its nearest node, which is a box of
-/// one cell; the self-induced correction must see that box).
+/// The half-widths [m] of the box whose unbounded Stokes response the self-induced correction
+/// subtracts: the filter box convolved with the grid's hat functions has the variance
+/// `h²/3 + Δ²/6` per axis, which a box of half-width `sqrt(h² + Δ²/2)` matches (Δ the local
+/// spacing; along z the gap to the next level).
 fn effective_half(grid: &ChannelGrid, x: DVec3, half: DVec3) -> DVec3 {
     let k = grid.level_below(x.z).unwrap_or(0).min(grid.nz - 2);
     let dz = grid.z(k + 1) - grid.z(k);
-    half.max(0.5 * DVec3::new(grid.dx(), grid.dy(), dz))
+    let d = DVec3::new(grid.dx(), grid.dy(), dz);
+    (half * half + 0.5 * d * d).map(f64::sqrt)
 }
 
 /// Sample the liquid at each particle (`Prepare`).
@@ -142,9 +146,11 @@ pub fn sample_liquid(
     let correct = lq.spec.self_induced_correction;
     q.par_iter_mut()
         .for_each(|(x, o, body, spheroid, mut c, mut sample)| {
-            let half = effective_half(grid, x.0, half_widths(body, spheroid, o));
-            if correct && half != c.half_widths {
-                c.mobility = self_mobility(half, mu);
+            let half = half_widths(body, spheroid, o);
+            let level = grid.level_below(x.0.z);
+            if correct && (half != c.half_widths || level != c.mobility_level) {
+                c.mobility = self_mobility(effective_half(grid, x.0, half), mu);
+                c.mobility_level = level;
             }
             c.half_widths = half;
             let Some(st) = FilterStencil::new(grid, &lq.z_weights, x.0, half) else {
