@@ -25,4 +25,6 @@ pub use solver::{ChannelError, ChannelParams};
 pub use stepper::ChannelSolver;
 
 #[cfg(test)]
+mod budget_tests;
+#[cfg(test)]
 mod solver_tests;
