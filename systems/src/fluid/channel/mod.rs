@@ -27,4 +27,6 @@ pub use stepper::ChannelSolver;
 #[cfg(test)]
 mod budget_tests;
 #[cfg(test)]
+mod os_tests;
+#[cfg(test)]
 mod solver_tests;
