@@ -30,3 +30,5 @@ mod budget_tests;
 mod os_tests;
 #[cfg(test)]
 mod solver_tests;
+#[cfg(test)]
+mod timing_tests;
