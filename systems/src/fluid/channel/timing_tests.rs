@@ -9,7 +9,7 @@ use std::time::Instant;
 #[test]
 #[ignore = "release tier: timing report, prints seconds per step"]
 fn step_timing_report() {
-    for (n, nz, steps) in [(32, 33, 20), (64, 65, 5)] {
+    for (n, nz, steps) in [(32, 33, 20), (64, 65, 5), (128, 129, 2)] {
         let g = ChannelGrid::new([n, n, nz], [1.0, 1.0, 0.5]).unwrap();
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new()
