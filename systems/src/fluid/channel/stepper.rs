@@ -165,7 +165,8 @@ impl ChannelSolver {
     }
 
     /// Body force per unit mass \[m/s²\] at the nodes (x, y, z components), held constant over
-    /// the next step; the caller overwrites it before each step. Zero initially.
+    /// the next step; the caller overwrites it before each step (it is kept, not cleared,
+    /// between steps). Zero initially, and after [`ChannelSolver::from_state_bytes`].
     pub fn body_force_mut(&mut self) -> [&mut [f64]; 3] {
         let [a, b, c] = &mut self.force;
         [a, b, c]
