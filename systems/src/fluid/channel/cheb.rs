@@ -22,24 +22,34 @@ use std::f64::consts::PI;
 #[inline]
 pub(crate) fn matvec_c(a: &[f64], n_cols: usize, x: &[C], y: &mut [C]) {
     for (row, yr) in a.chunks_exact(n_cols).zip(y.iter_mut()) {
-        let (mut re, mut im) = (0.0, 0.0);
-        for (aij, xj) in row.iter().zip(x) {
-            re += aij * xj.re;
-            im += aij * xj.im;
-        }
-        *yr = C::new(re, im);
+        *yr = row_dot_c(row, &x[..n_cols]);
     }
 }
 
-/// One row of a real matrix applied to complex data.
+/// One row of a real matrix applied to complex data. Four independent partial sums per
+/// component (fixed order, so bit-reproducible) let the products pipeline.
 #[inline]
 pub(crate) fn row_dot_c(row: &[f64], x: &[C]) -> C {
-    let (mut re, mut im) = (0.0, 0.0);
-    for (aij, xj) in row.iter().zip(x) {
-        re += aij * xj.re;
-        im += aij * xj.im;
+    let n = row.len().min(x.len());
+    let (row, x) = (&row[..n], &x[..n]);
+    let mut re = [0.0f64; 4];
+    let mut im = [0.0f64; 4];
+    let (rc, rr) = row.split_at(n - n % 4);
+    let (xc, xr) = x.split_at(n - n % 4);
+    for (a, b) in rc.chunks_exact(4).zip(xc.chunks_exact(4)) {
+        for l in 0..4 {
+            re[l] += a[l] * b[l].re;
+            im[l] += a[l] * b[l].im;
+        }
     }
-    C::new(re, im)
+    for (a, b) in rr.iter().zip(xr) {
+        re[0] += a * b.re;
+        im[0] += a * b.im;
+    }
+    C::new(
+        (re[0] + re[1]) + (re[2] + re[3]),
+        (im[0] + im[1]) + (im[2] + im[3]),
+    )
 }
 
 /// Reference coordinates `ξ_k = −cos(π k/N)` of the levels, in the symmetric sine form.

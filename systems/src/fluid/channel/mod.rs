@@ -33,6 +33,12 @@ pub use solver::{ChannelError, ChannelParams};
 pub use stepper::ChannelSolver;
 
 #[cfg(test)]
+mod budget_tests;
+#[cfg(test)]
 mod coupling_tests;
 #[cfg(test)]
+mod os_tests;
+#[cfg(test)]
 mod solver_tests;
+#[cfg(test)]
+mod timing_tests;

@@ -39,7 +39,25 @@
 //! then `w` from `∇²w = φ`, `w = 0`; the two clamping conditions `∂_z w = 0` are met by the
 //! influence-matrix method: a particular solution (`φ = 0` at the walls) plus the two
 //! homogeneous solutions with `φ = 1` at one wall, combined per mode and stage by a 2 × 2 solve.
-//! The homogeneous solutions are recomputed (cheap, no per-mode storage).
+//! The homogeneous solutions depend only on the mode and the stage; they and the inverses of
+//! their 2 × 2 wall-slope matrices are precomputed when the solver is built (`3 · 2 · nz` reals
+//! per mode: about 51 MB for a 128 × 128 × 129 grid, whose whole solver state stays a few
+//! hundred MB). Nothing else is stored per mode.
+//!
+//! # Choices and deviations
+//!
+//! * The z-vorticity right-hand side is `h_η = ∂_x H_y − ∂_y H_x`, the z-component of
+//!   `∇ × H` for `η = ∂v/∂x − ∂u/∂y` (the form `∂_y H_x − ∂_x H_y` would be the sign of
+//!   Kim-Moin-Moser's y-normal vorticity transcribed without the change of axes). The forced
+//!   steady-state test fails with the opposite sign.
+//! * Crank-Nicolson splits each stage's implicit weight evenly, `α_s = β_s`, rather than
+//!   Spalart-Moser-Rogers' unequal pairs; both sum to `γ_s + ζ_s`, both are second order.
+//! * `φ = ∇²w` is recomputed from `w` (`D2 w − k² w`) at every stage, so the state is `w`, `η`,
+//!   U and V only; the previous-stage right-hand sides are not part of the state because the
+//!   first stage has `ζ = 0`. Restarts are therefore exact.
+//! * A field given to [`ChannelSolver::set_velocity`](super::stepper::ChannelSolver::set_velocity)
+//!   keeps its w and η per mode; w's wall values and slopes are removed by cubic Hermite
+//!   polynomials (a projection that leaves admissible fields unchanged).
 //!
 //! Parallelism: rayon over z-planes (transforms) and over Fourier modes (wall-normal solves);
 //! every value is computed by one task in a fixed order, so results are bit-for-bit identical
@@ -221,39 +239,70 @@ impl Ops {
         )
     }
 
-    /// The clamped w of mode `k2` whose Laplacian, away from the walls, solves the Helmholtz
-    /// equation `(1 + b k2 − b ∂²) φ = r` (r at interior levels): the influence-matrix
-    /// solution. `b > 0`. Writes w into `w`; `work` needs `6 nz` slots.
-    pub(crate) fn clamped_solve(&self, b: f64, k2: f64, r: &[C], w: &mut [C], work: &mut [C]) {
+    /// The two homogeneous solutions of the clamped w-problem of wavenumber² `k2` and implicit
+    /// weight `b > 0`: `φ = 1` at the bottom (`h1`) or top (`h2`) wall, `(1 + b k2 − b ∂²) φ = 0`
+    /// inside, `∇²w = φ` inside, `w = 0` at the walls. Returns the inverse of the matrix of
+    /// their wall slopes, row-major `[[∂w1(0), ∂w2(0)], [∂w1(h), ∂w2(h)]]⁻¹`. `work` needs
+    /// `4 nz` slots.
+    pub(crate) fn homogeneous(
+        &self,
+        b: f64,
+        k2: f64,
+        h1: &mut [f64],
+        h2: &mut [f64],
+        work: &mut [C],
+    ) -> [f64; 4] {
         let nz = self.nz;
         let (phi, rest) = work.split_at_mut(nz);
-        let (h1, rest) = rest.split_at_mut(nz);
-        let (h2, rest) = rest.split_at_mut(nz);
-        let (tmp, _) = rest.split_at_mut(2 * nz);
+        let (out, tmp) = rest.split_at_mut(nz);
         let one = C::new(1.0, 0.0);
-        // particular
+        let mut slopes = [(ZERO, ZERO); 2];
+        for (wall, h) in [h1, h2].into_iter().enumerate() {
+            let zero = vec![ZERO; nz];
+            let (f0, f_n) = if wall == 0 { (one, ZERO) } else { (ZERO, one) };
+            self.helm.solve(1.0, b, k2, &zero, f0, f_n, phi, tmp);
+            phi.iter_mut().for_each(|p| *p = -*p);
+            self.helm.solve(0.0, 1.0, k2, phi, ZERO, ZERO, out, tmp);
+            out[0] = ZERO;
+            out[nz - 1] = ZERO;
+            for k in 0..nz {
+                h[k] = out[k].re;
+            }
+            slopes[wall] = self.wall_dz(out);
+        }
+        let (a00, a10) = (slopes[0].0.re, slopes[0].1.re);
+        let (a01, a11) = (slopes[1].0.re, slopes[1].1.re);
+        let det = a00 * a11 - a01 * a10;
+        [a11 / det, -a01 / det, -a10 / det, a00 / det]
+    }
+
+    /// The clamped w of wavenumber² `k2` whose Laplacian, away from the walls, solves the
+    /// Helmholtz equation `(1 + b k2 − b ∂²) φ = r` (r at interior levels), `w = ∂w = 0` at
+    /// the walls: the influence-matrix solution with the precomputed homogeneous solutions
+    /// `h1`, `h2` and slope-matrix inverse `inv` of [`Ops::homogeneous`]. `work` needs `3 nz`
+    /// slots.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn clamped_solve(
+        &self,
+        b: f64,
+        k2: f64,
+        r: &[C],
+        w: &mut [C],
+        work: &mut [C],
+        h1: &[f64],
+        h2: &[f64],
+        inv: [f64; 4],
+    ) {
+        let nz = self.nz;
+        let (phi, tmp) = work.split_at_mut(nz);
         self.helm.solve(1.0, b, k2, r, ZERO, ZERO, phi, tmp);
         phi.iter_mut().for_each(|p| *p = -*p);
         self.helm.solve(0.0, 1.0, k2, phi, ZERO, ZERO, w, tmp);
-        // homogeneous: φ = 1 at one wall
-        phi.fill(ZERO);
-        self.helm.solve(1.0, b, k2, phi, one, ZERO, h1, tmp);
-        h1.iter_mut().for_each(|p| *p = -*p);
-        phi.copy_from_slice(h1);
-        self.helm.solve(0.0, 1.0, k2, phi, ZERO, ZERO, h1, tmp);
-        phi.fill(ZERO);
-        self.helm.solve(1.0, b, k2, phi, ZERO, one, h2, tmp);
-        h2.iter_mut().for_each(|p| *p = -*p);
-        phi.copy_from_slice(h2);
-        self.helm.solve(0.0, 1.0, k2, phi, ZERO, ZERO, h2, tmp);
         let (p0, pn) = self.wall_dz(w);
-        let (a00, a10) = self.wall_dz(h1);
-        let (a01, a11) = self.wall_dz(h2);
-        let det = a00.re * a11.re - a01.re * a10.re;
-        let c1 = -(p0 * a11.re - pn * a01.re) / det;
-        let c2 = -(pn * a00.re - p0 * a10.re) / det;
+        let c1 = -(p0 * inv[0] + pn * inv[1]);
+        let c2 = -(p0 * inv[2] + pn * inv[3]);
         for k in 0..nz {
-            w[k] += c1 * h1[k].re + c2 * h2[k].re;
+            w[k] += c1 * h1[k] + c2 * h2[k];
         }
         w[0] = ZERO;
         w[nz - 1] = ZERO;

@@ -215,3 +215,59 @@ fn divergence_stays_at_round_off() {
     assert!(d0 < 1e-12 && d1 < 1e-12, "{d0} {d1}");
     assert!(s.velocity().iter().all(|c| c.iter().all(|v| v.is_finite())));
 }
+
+/// The least-damped even Stokes mode of the clamped z-velocity: `w = W(z) cos(k x) e^{−σt}`,
+/// `W = cos(p ζ)/cos(p a) − cosh(k ζ)/cosh(k a)` with `ζ = z − a`, `a = h/2`,
+/// `p tan(p a) = −k tanh(k a)` and `σ = ν (k² + p²)`: an exact solution of the Navier-Stokes
+/// equations (its nonlinear term is a gradient only to first order, so the amplitude is
+/// small). Returns the max error relative to the amplitude at `t_end`.
+fn stokes_w_mode_error(steps: usize, t_end: f64) -> f64 {
+    let (nu, lx, h) = (0.02, 2.0, 1.0);
+    let g = ChannelGrid::new([8, 4, 33], [lx, 1.0, h]).unwrap();
+    let mut s = ChannelSolver::new(ChannelParams::new(g, nu, t_end / steps as f64)).unwrap();
+    let (k, a) = (2.0 * PI / lx, 0.5 * h);
+    let f = |p: f64| p * (p * a).tan() + k * (k * a).tanh();
+    let (mut lo, mut hi) = (PI / (2.0 * a) + 1e-12, PI / a - 1e-12);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 { lo = mid } else { hi = mid }
+    }
+    let p = 0.5 * (lo + hi);
+    let sigma = nu * (k * k + p * p);
+    let amp = 1e-6;
+    let ww = |z: f64| {
+        amp * ((p * (z - a)).cos() / (p * a).cos() - (k * (z - a)).cosh() / (k * a).cosh())
+    };
+    let dw = |z: f64| {
+        amp * (-p * (p * (z - a)).sin() / (p * a).cos() - k * (k * (z - a)).sinh() / (k * a).cosh())
+    };
+    let u0 = field(&g, |x, _, z| -dw(z) * (k * x).sin() / k);
+    let w0 = field(&g, |x, _, z| ww(z) * (k * x).cos());
+    s.set_velocity([&u0, &vec![0.0; g.len()], &w0]).unwrap();
+    for _ in 0..steps {
+        s.step();
+    }
+    let decay = (-sigma * s.time()).exp();
+    let w1 = field(&g, |x, _, z| ww(z) * (k * x).cos() * decay);
+    let u1 = field(&g, |x, _, z| -dw(z) * (k * x).sin() / k * decay);
+    let wmax = w0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    max_abs_diff(s.velocity()[2], &w1).max(max_abs_diff(s.velocity()[0], &u1)) / wmax
+}
+
+#[test]
+fn stokes_w_mode_decays_at_the_exact_rate_second_order() {
+    let t_end = 4.0;
+    let e: Vec<f64> = [10, 20, 40]
+        .iter()
+        .map(|n| stokes_w_mode_error(*n, t_end))
+        .collect();
+    println!(
+        "Stokes w-mode: rel errors {e:?}, ratios {:.3} {:.3}",
+        e[0] / e[1],
+        e[1] / e[2]
+    );
+    assert!(e[2] < 1e-3, "{e:?}");
+    for r in [e[0] / e[1], e[1] / e[2]] {
+        assert!((3.6..4.4).contains(&r), "order: {r}");
+    }
+}

@@ -28,6 +28,10 @@ pub struct ChannelSolver {
     hw_prev: Vec<C>,
     heta_prev: Vec<C>,
     hm_prev: [Vec<f64>; 2],
+    /// Homogeneous clamped solutions `[stage][m][2][nz]` (influence matrix).
+    hom: Vec<f64>,
+    /// Inverse wall-slope matrices `[stage][m]`.
+    hom_inv: Vec<[f64; 4]>,
     pub(crate) force: [Vec<f64>; 3],
     pub(crate) vel: [Vec<f64>; 3],
     pub(crate) vort: [Vec<f64>; 3],
@@ -89,6 +93,35 @@ impl ChannelSolver {
         let ns = nmodes * g.nz;
         let n = g.len();
         let zf = || vec![0.0; n];
+        // influence-matrix homogeneous solutions per stage and mode: 2 nz reals each
+        let nz = g.nz;
+        let mut hom = vec![0.0; 3 * nmodes * 2 * nz];
+        let mut hom_inv = vec![[0.0; 4]; 3 * nmodes];
+        for s in 0..3 {
+            let b = 0.5 * (GAMMA[s] + ZETA[s]) * params.dt * params.viscosity;
+            let ops = &ops;
+            hom[s * nmodes * 2 * nz..(s + 1) * nmodes * 2 * nz]
+                .par_chunks_mut(2 * nz)
+                .zip(hom_inv[s * nmodes..(s + 1) * nmodes].par_iter_mut())
+                .enumerate()
+                .for_each_init(
+                    || vec![ZERO; 4 * nz],
+                    |work, (m, (h, inv))| {
+                        if m == 0 {
+                            return;
+                        }
+                        if let Some((kx, ky)) = ops.k(m) {
+                            let (h1, h2) = h.split_at_mut(nz);
+                            *inv = ops.homogeneous(b, kx * kx + ky * ky, h1, h2, work);
+                        }
+                    },
+                );
+        }
+        if hom_inv.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(ChannelError::Operators(super::cheb::ChebError::Eigen(
+                "singular influence matrix".into(),
+            )));
+        }
         Ok(Self {
             params,
             ops,
@@ -101,6 +134,8 @@ impl ChannelSolver {
             hw_prev: vec![ZERO; ns],
             heta_prev: vec![ZERO; ns],
             hm_prev: [vec![0.0; g.nz], vec![0.0; g.nz]],
+            hom,
+            hom_inv,
             force: [zf(), zf(), zf()],
             vel: [zf(), zf(), zf()],
             vort: [zf(), zf(), zf()],
@@ -130,7 +165,8 @@ impl ChannelSolver {
     }
 
     /// Body force per unit mass \[m/s²\] at the nodes (x, y, z components), held constant over
-    /// the next step; the caller overwrites it before each step. Zero initially.
+    /// the next step; the caller overwrites it before each step (it is kept, not cleared,
+    /// between steps). Zero initially, and after [`ChannelSolver::from_state_bytes`].
     pub fn body_force_mut(&mut self) -> [&mut [f64]; 3] {
         let [a, b, c] = &mut self.force;
         [a, b, c]
@@ -348,7 +384,10 @@ impl ChannelSolver {
                     for k in 0..nz {
                         wk.r[k] = wk.a[k] + (wk.c[k] - wk.a[k] * k2) * a + wk.b[k] * dt;
                     }
-                    ops.clamped_solve(b, k2, &wk.r, &mut wk.out, &mut wk.work);
+                    let hs = &self.hom[(s * nm + m) * 2 * nz..(s * nm + m + 1) * 2 * nz];
+                    let (h1, h2) = hs.split_at(nz);
+                    let inv = self.hom_inv[s * nm + m];
+                    ops.clamped_solve(b, k2, &wk.r, &mut wk.out, &mut wk.work, h1, h2, inv);
                     wm.copy_from_slice(&wk.out);
                     // η
                     ops.dzz(em, &mut wk.a);
