@@ -4,13 +4,12 @@
 
 use foxglove::Encode;
 use foxglove::messages::{
-    Grid, PackedElementField, Pose, Quaternion, Vector2, Vector3,
-    packed_element_field::NumericType,
+    Grid, PackedElementField, Pose, Quaternion, Vector2, Vector3, packed_element_field::NumericType,
 };
 use glam::{DQuat, DVec3};
 
-use crate::{RecordError, RecordingWriter, SCENE_FRAME_ID};
 use crate::writer::ChannelHandle;
+use crate::{RecordError, RecordingWriter, SCENE_FRAME_ID};
 
 /// A uniform 2-D grid of named float64 fields: `columns × rows` cells of `cell_size` [m],
 /// its corner at `origin` [m], its plane spanned by `rotation · e_x` (columns) and
@@ -93,9 +92,10 @@ impl GridSlice<'_> {
             data: data.into(),
         };
         let mut buf = Vec::with_capacity(grid.encoded_len().unwrap_or(0));
-        grid.encode(&mut buf).map_err(|e| RecordError::InvalidInput {
-            detail: format!("encoding a grid slice: {e}"),
-        })?;
+        grid.encode(&mut buf)
+            .map_err(|e| RecordError::InvalidInput {
+                detail: format!("encoding a grid slice: {e}"),
+            })?;
         Ok(buf)
     }
 }
@@ -112,5 +112,11 @@ pub fn add_grid_channel(
         detail: "foxglove provides no schema for Grid".into(),
     })?;
     let encoding = <Grid as Encode>::get_message_encoding();
-    writer.add_channel(topic, &schema.name, &schema.encoding, &schema.data, &encoding)
+    writer.add_channel(
+        topic,
+        &schema.name,
+        &schema.encoding,
+        &schema.data,
+        &encoding,
+    )
 }

@@ -83,9 +83,11 @@ fn momenta(sim: &mut Simulation) -> (DVec3, DVec3) {
 
 #[test]
 fn the_coupled_momentum_budget_closes() {
-    // the particle's horizontal momentum goes into the liquid and nowhere else while the
-    // disturbance has not reached the walls (the wall shear is then negligible); the
-    // wall-normal component is taken up by the pressure (no net flow through the walls)
+    // every newton the particle loses goes into the liquid: after 20 steps the horizontal
+    // momentum of particle + liquid has changed by what crossed the walls, about 1e-6 of the
+    // particle's momentum (the viscous flux of the Chebyshev mean mode through the walls; it
+    // scales with the forcing, not its square, so it is not an error of the nonlinear terms).
+    // The wall-normal component is taken up by the pressure (no net flow through the walls).
     for history in [false, true] {
         let mut sim = simulation(&launched(
             r#"solver = { kind = "channel", grid = [16, 12, 25], coupling = "two_way" }"#,
@@ -94,17 +96,22 @@ fn the_coupled_momentum_budget_closes() {
         let (p0, f0) = momenta(&mut sim);
         assert_eq!(f0, DVec3::ZERO);
         let mut worst: f64 = 0.0;
+        let mut transferred: f64 = 0.0;
         for _ in 0..20 {
             sim.step();
             let (p, f) = momenta(&mut sim);
             let total = p + f - p0;
             worst = worst.max(total.truncate().length() / p0.truncate().length());
-            // the liquid has picked up the particle's momentum
-            assert!(f.truncate().length() > 0.0);
+            transferred = f.truncate().length() / p0.truncate().length();
         }
         let (p, _) = momenta(&mut sim);
         assert!(p.x < p0.x, "the particle must slow down");
-        assert!(worst < 1e-10, "history {history}: momentum error {worst:e}");
+        // the liquid took up a measurable share; the budget closes four orders of magnitude below it
+        assert!(transferred > 0.01, "transferred {transferred:e}");
+        assert!(
+            worst < 1e-4 * transferred,
+            "history {history}: momentum error {worst:e}"
+        );
     }
 }
 
@@ -123,7 +130,8 @@ fn one_way_coupling_and_no_solver_give_the_same_run() {
         (x, summary)
     };
     let (a, sa) = run("");
-    let (b, sb) = run(r#"solver = { kind = "channel", grid = [16, 12, 25], coupling = "one_way" }"#);
+    let (b, sb) =
+        run(r#"solver = { kind = "channel", grid = [16, 12, 25], coupling = "one_way" }"#);
     assert_eq!(a, b);
     assert!(sa["liquid_solver"].is_null());
     assert_eq!(sb["liquid_solver"]["solved"], false);
@@ -136,25 +144,29 @@ fn one_way_coupling_and_no_solver_give_the_same_run() {
 
 #[test]
 fn a_settling_sphere_approaches_stokes_with_the_self_induced_correction() {
-    // d/Δ = 1 and 2: without the correction the sphere feels its own disturbance and settles
-    // too slowly, increasingly so as the grid resolves the filter; with it the velocity is
-    // within the hindrance of walls and periodic images (a few per cent) of Stokes
+    // d/Δ = 1 and 2 in a box of 16 diameters: the uncorrected point particle is carried by its
+    // own disturbance and settles 50-70 % too fast, increasingly so as the grid resolves the
+    // filter; with the correction it settles within the hindrance of the walls (8 diameters
+    // away) and of the periodic images (about 10 %) of Stokes, and in a box twice as large it
+    // moves towards Stokes
     let v = stokes_velocity();
     assert!((v - 2.18e-5).abs() < 1e-7);
     let raw: Vec<f64> = [16, 32]
         .iter()
-        .map(|&n| settle(n, false, 0.2).unwrap().ratio)
+        .map(|&n| settle(n, 16.0, false, 0.2).unwrap().ratio)
         .collect();
     let fixed: Vec<f64> = [16, 32]
         .iter()
-        .map(|&n| settle(n, true, 0.2).unwrap().ratio)
+        .map(|&n| settle(n, 16.0, true, 0.2).unwrap().ratio)
         .collect();
     eprintln!("uncorrected {raw:?}, corrected {fixed:?}");
-    assert!(raw[1] < raw[0] && raw[1] < 0.8, "uncorrected {raw:?}");
+    assert!(raw[0] > 1.3 && raw[1] > raw[0], "uncorrected {raw:?}");
     for r in &fixed {
-        assert!((r - 1.0).abs() < 0.12, "corrected {fixed:?}");
+        assert!((0.85..1.0).contains(r), "corrected {fixed:?}");
     }
-    assert!((fixed[1] - 1.0).abs() < (raw[1] - 1.0).abs());
+    let wide = settle(32, 32.0, true, 0.2).unwrap().ratio;
+    eprintln!("corrected, box of 32 diameters: {wide}");
+    assert!(wide > fixed[0] && wide < 1.02, "{wide}");
 }
 
 #[test]
@@ -162,7 +174,12 @@ fn a_settling_sphere_approaches_stokes_with_the_self_induced_correction() {
 fn settling_converges_as_the_grid_resolves_the_filter() {
     let rows: Vec<_> = [8, 16, 32, 48, 64]
         .iter()
-        .map(|&n| (settle(n, false, 0.3).unwrap(), settle(n, true, 0.3).unwrap()))
+        .map(|&n| {
+            (
+                settle(n, 16.0, false, 0.3).unwrap(),
+                settle(n, 16.0, true, 0.3).unwrap(),
+            )
+        })
         .collect();
     for (raw, fixed) in &rows {
         eprintln!(
@@ -170,47 +187,10 @@ fn settling_converges_as_the_grid_resolves_the_filter() {
             raw.diameter_over_spacing, raw.ratio, fixed.ratio
         );
     }
-    // corrected: converged to within 2 % between the two finest grids and within the
-    // hindrance estimate of Stokes
+    // corrected: converged to within 2 % between the two finest grids, within the confinement
+    // hindrance of Stokes; uncorrected: far off and drifting
     let (a, b) = (rows[3].1.ratio, rows[4].1.ratio);
     assert!((a - b).abs() < 0.02, "{a} {b}");
-    assert!((b - 1.0).abs() < 0.1, "{b}");
-}
-
-#[test]
-#[ignore = "diagnostic"]
-fn momentum_budget_diagnostic() {
-    for speed in [1.0, 0.01] {
-        let mut sim = simulation(&launched_at(
-            r#"solver = { kind = "channel", grid = [16, 12, 25], coupling = "two_way" }"#,
-            false,
-            speed,
-        ));
-        let (p0, _) = momenta(&mut sim);
-        let mut shear = glam::DVec2::ZERO;
-        for step in 0..20 {
-            let before = {
-                let l = sim.app.world.resource::<ChannelLiquid>();
-                l.solver.wall_shear()
-            };
-            sim.step();
-            let l = sim.app.world.resource::<ChannelLiquid>();
-            let after = l.solver.wall_shear();
-            let g = *l.grid();
-            let area = g.lx * g.ly * 1000.0;
-            // force of the walls on the liquid: ρ ν (−∂U/∂z at the bottom + ∂U/∂z at the top)·A,
-            // i.e. −(top shear) ... trapezoid in time
-            for c in 0..2 {
-                let f0 = after[1][c] - after[0][c];
-                let f1 = before[1][c] - before[0][c];
-                shear[c] -= 0.5 * (f0 + f1) * area * 1e-3;
-            }
-            let (p, f) = momenta(&mut sim);
-            let total = (p + f - p0).truncate();
-            eprintln!(
-                "speed {speed} step {step}: budget {:.3e} {:.3e}  wall impulse {:.3e} {:.3e}  rel {:.3e}",
-                total.x, total.y, shear.x, shear.y, total.length() / p0.truncate().length()
-            );
-        }
-    }
+    assert!((0.85..1.0).contains(&b), "{b}");
+    assert!(rows[4].0.ratio > 1.5);
 }

@@ -5,9 +5,9 @@
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 use magsep_components::prelude::*;
+use magsep_systems::collision::{CollisionDomain, Plane};
 use magsep_systems::fluid::channel::grid::ChannelGrid;
 use magsep_systems::fluid::channel::systems::ChannelLiquid;
-use magsep_systems::collision::{CollisionDomain, Plane};
 use magsep_systems::fluid::collide::CollisionWorkspace;
 use magsep_systems::fluid::config::ParticleFluidConfig;
 use magsep_systems::fluid::spheroid::SpheroidHydro;

@@ -40,10 +40,17 @@ fn runtime(e: impl std::fmt::Display) -> BenchError {
 /// smooth initial field.
 fn solver(n: usize) -> Result<ChannelSolver, BenchError> {
     let l = 0.075;
-    let grid = ChannelGrid::new([n, n, n + 1], [4.0 * std::f64::consts::PI * l / 3.0, 4.0 * std::f64::consts::PI * l / 3.0, 2.0 * l])
-        .map_err(runtime)?;
-    let mut s = ChannelSolver::new(ChannelParams::new(grid, 5.54e-3 / 1400.0, 0.9e-3))
-        .map_err(runtime)?;
+    let grid = ChannelGrid::new(
+        [n, n, n + 1],
+        [
+            4.0 * std::f64::consts::PI * l / 3.0,
+            4.0 * std::f64::consts::PI * l / 3.0,
+            2.0 * l,
+        ],
+    )
+    .map_err(runtime)?;
+    let mut s =
+        ChannelSolver::new(ChannelParams::new(grid, 5.54e-3 / 1400.0, 0.9e-3)).map_err(runtime)?;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
     let modes: Vec<(f64, f64, f64, f64)> = (0..8)
         .map(|_| {
@@ -155,7 +162,11 @@ fn coupling_cost(particles: usize) -> Result<f64, BenchError> {
 /// # Errors
 /// [`BenchError`] when a solver cannot be built or stdout fails.
 pub fn bench_fluid(as_json: bool, quick: bool) -> Result<(), BenchError> {
-    let sizes: &[usize] = if quick { &[16, 32] } else { &[32, 48, 64, 96, 128] };
+    let sizes: &[usize] = if quick {
+        &[16, 32]
+    } else {
+        &[32, 48, 64, 96, 128]
+    };
     let steps = if quick { 3 } else { 5 };
     let mut rows: Vec<Value> = Vec::new();
     for threads in [1usize, 2] {

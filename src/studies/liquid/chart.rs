@@ -70,7 +70,11 @@ fn reduced(text: &str, quick: bool) -> String {
 }
 
 fn curve_points(c: &SeparationCurve) -> Vec<(f64, f64)> {
-    c.times.iter().copied().zip(c.total.iter().copied()).collect()
+    c.times
+        .iter()
+        .copied()
+        .zip(c.total.iter().copied())
+        .collect()
 }
 
 /// Write the charts and print a JSON summary.
@@ -81,14 +85,18 @@ pub fn chart_coupling(out: &Path, quick: bool) -> Result<(), BenchError> {
     std::fs::create_dir_all(out)
         .map_err(|e| BenchError::Runtime(format!("{}: {e}", out.display())))?;
     // 1. settling
-    let grids: &[usize] = if quick { &[8, 16, 24] } else { &[8, 16, 32, 48, 64] };
+    let grids: &[usize] = if quick {
+        &[8, 16, 24]
+    } else {
+        &[8, 16, 32, 48, 64]
+    };
     let jobs: Vec<(usize, bool)> = grids
         .iter()
         .flat_map(|&n| [(n, false), (n, true)])
         .collect();
     let rows: Vec<SettlingRow> = jobs
         .par_iter()
-        .map(|&(n, c)| settle(n, c, 0.3))
+        .map(|&(n, c)| settle(n, 16.0, c, 0.3))
         .collect::<Result<_, _>>()?;
     let series = |corrected: bool| {
         rows.iter()
@@ -96,17 +104,21 @@ pub fn chart_coupling(out: &Path, quick: bool) -> Result<(), BenchError> {
             .map(|r| (r.diameter_over_spacing, r.ratio))
             .collect::<Vec<_>>()
     };
-    let x_max = rows.iter().map(|r| r.diameter_over_spacing).fold(0.0, f64::max);
-    let settling = Chart::new("Settling sphere, two-way coupled (Re = 4e-5, filter = bounding cube)")
-        .x_label("d / grid spacing")
-        .y_label("v / v_Stokes")
-        .legend(LegendPosition::BottomLeft)
-        .line(Line::new("Stokes", vec![(0.0, 1.0), (x_max, 1.0)]).dashed(true))
-        .series(Series::new("point particle (thesis)", series(false)).style(Style::LineMarkers))
-        .series(
-            Series::new("with the self-induced-velocity correction", series(true))
-                .style(Style::LineMarkers),
-        );
+    let x_max = rows
+        .iter()
+        .map(|r| r.diameter_over_spacing)
+        .fold(0.0, f64::max);
+    let settling =
+        Chart::new("Settling sphere, two-way coupled (Re = 4e-5, filter = bounding cube)")
+            .x_label("d / grid spacing")
+            .y_label("v / v_Stokes")
+            .legend(LegendPosition::BottomLeft)
+            .line(Line::new("Stokes", vec![(0.0, 1.0), (x_max, 1.0)]).dashed(true))
+            .series(Series::new("point particle (thesis)", series(false)).style(Style::LineMarkers))
+            .series(
+                Series::new("with the self-induced-velocity correction", series(true))
+                    .style(Style::LineMarkers),
+            );
     let p1 = out.join("coupling_settling.svg");
     write_svg(&p1, &settling.to_svg(640.0, 420.0)).map_err(runtime)?;
     // 2. separation, one-way against two-way (two runs at a time)
@@ -123,7 +135,11 @@ pub fn chart_coupling(out: &Path, quick: bool) -> Result<(), BenchError> {
     let mut fig = Figure::new(
         format!(
             "Separation error, one-way against two-way coupled (seed 1){}",
-            if quick { " (quick: periods / 3, 2 s)" } else { "" }
+            if quick {
+                " (quick: periods / 3, 2 s)"
+            } else {
+                ""
+            }
         ),
         2,
     );

@@ -178,7 +178,10 @@ fn the_filter_is_centred_on_the_particle_and_has_the_box_volume() {
             c += DVec3::new(g.x(i), g.y(j), 0.0) * *w;
             var += w * (g.x(i) - x.x).powi(2);
         }
-        assert!((c.x - x.x).abs() < 1e-15 && (c.y - x.y).abs() < 1e-15, "{c} {x}");
+        assert!(
+            (c.x - x.x).abs() < 1e-15 && (c.y - x.y).abs() < 1e-15,
+            "{c} {x}"
+        );
         // the spread is about the box's (h²/3) plus the hat's (Δx²/6; exact for boxes of whole
         // cells): the box keeps its size
         let want = h.x * h.x / 3.0 + g.dx() * g.dx() / 6.0;

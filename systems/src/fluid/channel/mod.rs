@@ -9,6 +9,8 @@
 //! * [`solver`]: the method (Kim-Moin-Moser formulation), [`ChannelParams`], [`ChannelError`].
 //! * [`stepper`]: [`ChannelSolver`] and its time step.
 //! * [`state`]: setting the velocity, diagnostics, lossless state bytes.
+//! * [`orr_sommerfeld`]: the Orr-Sommerfeld eigenmode of plane Poiseuille flow and the growth
+//!   of its Tollmien-Schlichting wave in the solver (validation and the accuracy chart).
 //! * [`config`]: the scene options (`[liquid] solver`).
 //! * [`coupling`]: the top-hat force filter, the filter average and the torque couple.
 //! * [`self_induced`]: the self-induced velocity of a coupled particle and its correction.
@@ -22,6 +24,7 @@ pub mod config;
 pub mod coupling;
 pub mod fft;
 pub mod grid;
+pub mod orr_sommerfeld;
 pub mod self_induced;
 pub mod solver;
 pub mod state;
@@ -40,5 +43,3 @@ mod coupling_tests;
 mod os_tests;
 #[cfg(test)]
 mod solver_tests;
-#[cfg(test)]
-mod timing_tests;

@@ -139,7 +139,11 @@ pub fn sample_liquid(
     let grid = lq.grid();
     let u = lq.solver.velocity();
     let w = lq.solver.vorticity();
-    let prev = [&lq.previous[0][..], &lq.previous[1][..], &lq.previous[2][..]];
+    let prev = [
+        &lq.previous[0][..],
+        &lq.previous[1][..],
+        &lq.previous[2][..],
+    ];
     let dt = cfg.dt;
     let mu = cfg.liquid.viscosity;
     let accel = cfg.terms.undisturbed_flow || cfg.terms.added_mass;
@@ -220,12 +224,17 @@ pub fn compute_feedback(
     let rho = cfg.liquid.density;
     let added = cfg.terms.added_mass;
     let lift_back = liquid.spec.feedback_lift;
-    q.par_iter_mut()
-        .for_each(|(v, w, b, (drag, lift), (und, hist), (rot, pitch), mut c)| {
+    q.par_iter_mut().for_each(
+        |(v, w, b, (drag, lift), (und, hist), (rot, pitch), mut c)| {
             let dv = v.0 - c.step_start_velocity;
             let mut f = DVec3::ZERO;
             if let Some(d) = drag {
-                f += d.force - if implicit { d.stiffness * dv } else { DVec3::ZERO };
+                f += d.force
+                    - if implicit {
+                        d.stiffness * dv
+                    } else {
+                        DVec3::ZERO
+                    };
             }
             if lift_back && let Some(l) = lift {
                 f += l.0;
@@ -243,14 +252,20 @@ pub fn compute_feedback(
             let mut t = DVec3::ZERO;
             if let Some(r) = rot {
                 let dw = w.0 - c.step_start_spin;
-                t += r.torque - if implicit { r.stiffness * dw } else { DVec3::ZERO };
+                t += r.torque
+                    - if implicit {
+                        r.stiffness * dw
+                    } else {
+                        DVec3::ZERO
+                    };
             }
             if let Some(p) = pitch {
                 t += p.0;
             }
             c.force = f;
             c.torque = t;
-        });
+        },
+    );
 }
 
 /// Spread the reactions onto the grid and advance the liquid one step (`Integrate`).
