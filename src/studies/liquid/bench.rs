@@ -115,6 +115,7 @@ fn coupling_cost(particles: usize) -> Result<f64, BenchError> {
     let s = solver(64)?;
     let g = *s.grid();
     let zw = g.z_quadrature_weights();
+    let zl = g.z_levels();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
     let xs: Vec<DVec3> = (0..particles)
         .map(|_| {
@@ -132,7 +133,7 @@ fn coupling_cost(particles: usize) -> Result<f64, BenchError> {
     let start = Instant::now();
     let mut acc = DVec3::ZERO;
     for x in &xs {
-        let Some(st) = FilterStencil::new(&g, &zw, *x, half) else {
+        let Some(st) = FilterStencil::new(&g, &zw, &zl, *x, half) else {
             continue;
         };
         let v = st.average3(u);
@@ -141,8 +142,8 @@ fn coupling_cost(particles: usize) -> Result<f64, BenchError> {
             let mut e = DVec3::ZERO;
             e[k] = half[k];
             if let (Some(p), Some(m)) = (
-                FilterStencil::new(&g, &zw, *x + e, half),
-                FilterStencil::new(&g, &zw, *x - e, half),
+                FilterStencil::new(&g, &zw, &zl, *x + e, half),
+                FilterStencil::new(&g, &zw, &zl, *x - e, half),
             ) {
                 acc += v[k] * (p.average3(u) - m.average3(u));
             }

@@ -9,7 +9,7 @@
 //!   `flakes_case5_coupled.toml`).
 //!
 //! Full mode runs the scenes as shipped (seed 1; the summary states the seed); `--quick`
-//! shrinks the sphere channel's periods by 3 (particle count by 9, grid 22 × 22 × 65), runs
+//! shrinks the sphere channel's periods by 3 (particle count by 9, grid 12 × 12 × 33), runs
 //! 2 s and only the settling grids up to d/Δ = 1.5.
 
 use std::path::Path;
@@ -64,7 +64,7 @@ fn reduced(text: &str, quick: bool) -> String {
     }
     let side = std::f64::consts::PI * 0.1 / 3.0;
     text.replace(&format!("[{SIDE}, {SIDE}]"), &format!("[{side}, {side}]"))
-        .replace("grid = [64, 64, 65]", "grid = [22, 22, 65]")
+        .replace("grid = [32, 32, 33]", "grid = [12, 12, 33]")
         .replace("duration = 5.0 ", "duration = 2.0 ")
         .replace("duration = 6.0 ", "duration = 2.0 ")
 }

@@ -104,12 +104,20 @@ fn periodic_weights(centre: f64, half: f64, n: usize, d: f64) -> Vec<(usize, f64
     out
 }
 
-/// Hat weights of the interior levels overlapping `[z − h, z + h]`.
-fn level_weights(grid: &ChannelGrid, z: f64, half: f64) -> Vec<(usize, f64)> {
+/// Hat weights of the interior levels overlapping `[z − h, z + h]`; `levels` are the grid's
+/// z levels (ascending).
+fn level_weights(levels: &[f64], z: f64, half: f64) -> Vec<(usize, f64)> {
     let (lo, hi) = (z - half, z + half);
-    (1..grid.nz - 1)
+    let nz = levels.len();
+    // levels whose hat [z_{k-1}, z_{k+1}] can overlap [lo, hi]
+    let first = levels
+        .partition_point(|v| *v <= lo)
+        .saturating_sub(1)
+        .max(1);
+    let last = (levels.partition_point(|v| *v < hi) + 1).min(nz - 1);
+    (first..last)
         .filter_map(|k| {
-            let (a, b, c) = (grid.z(k - 1), grid.z(k), grid.z(k + 1));
+            let (a, b, c) = (levels[k - 1], levels[k], levels[k + 1]);
             let f = hat_integral(lo, hi, a, b, c) / (0.5 * (c - a));
             (f > 0.0).then_some((k, f))
         })
@@ -120,8 +128,15 @@ impl FilterStencil {
     /// The stencil of a box of half-widths `half` [m] centred at `centre` [m] (x and y are
     /// wrapped; along z only interior levels take part, a box reaching past them is clipped,
     /// and a box outside the interior falls back to the nearest interior level). `zw` are the
-    /// grid's [`ChannelGrid::z_quadrature_weights`]. `None` for a non-finite centre or box.
-    pub fn new(grid: &ChannelGrid, zw: &[f64], centre: DVec3, half: DVec3) -> Option<Self> {
+    /// grid's [`ChannelGrid::z_quadrature_weights`] and `levels` its [`ChannelGrid::z_levels`]
+    /// (passed in because they cost a cosine each). `None` for a non-finite centre or box.
+    pub fn new(
+        grid: &ChannelGrid,
+        zw: &[f64],
+        levels: &[f64],
+        centre: DVec3,
+        half: DVec3,
+    ) -> Option<Self> {
         if !(centre.is_finite() && half.is_finite()) {
             return None;
         }
@@ -129,7 +144,7 @@ impl FilterStencil {
         let half = half.max(DVec3::splat(1e-12 * dx.min(dy)));
         let xs = periodic_weights(centre.x, half.x, grid.nx, dx);
         let ys = periodic_weights(centre.y, half.y, grid.ny, dy);
-        let mut zs = level_weights(grid, centre.z, half.z);
+        let mut zs = level_weights(levels, centre.z, half.z);
         if zs.is_empty() {
             let k = grid.level_below(centre.z)?.clamp(1, grid.nz - 2);
             zs.push((k, 1.0));

@@ -11,6 +11,7 @@ fn grid() -> ChannelGrid {
 
 fn integrate(g: &ChannelGrid, f: &[&mut [f64]; 3], rho: f64) -> DVec3 {
     let zw = g.z_quadrature_weights();
+    let zl = g.z_levels();
     let mut s = DVec3::ZERO;
     for k in 0..g.nz {
         for i in 0..g.nx {
@@ -28,6 +29,7 @@ fn integrate(g: &ChannelGrid, f: &[&mut [f64]; 3], rho: f64) -> DVec3 {
 fn m6_the_filtered_force_integrates_to_the_particle_forces() {
     let g = grid();
     let zw = g.z_quadrature_weights();
+    let zl = g.z_levels();
     let rho = 1400.0;
     let (mut a, mut b, mut c) = (vec![0.0; g.len()], vec![0.0; g.len()], vec![0.0; g.len()]);
     let mut total = DVec3::ZERO;
@@ -45,7 +47,7 @@ fn m6_the_filtered_force_integrates_to_the_particle_forces() {
     ];
     for (n, (x, h)) in cases.iter().enumerate() {
         let f = DVec3::new(1e-4 * n as f64, -2e-4, 3e-4 + 1e-5 * n as f64);
-        let s = FilterStencil::new(&g, &zw, *x, *h).unwrap();
+        let s = FilterStencil::new(&g, &zw, &zl, *x, *h).unwrap();
         // Σ P ΔV = 1 and no wall node
         let unit: f64 = s.weights.iter().sum();
         assert!((unit - 1.0).abs() < 1e-14);
@@ -67,8 +69,15 @@ fn m6_the_filtered_force_integrates_to_the_particle_forces() {
 fn the_filter_average_is_the_adjoint_of_spreading_and_exact_for_constants() {
     let g = grid();
     let zw = g.z_quadrature_weights();
-    let s =
-        FilterStencil::new(&g, &zw, DVec3::new(0.021, 0.013, 0.07), DVec3::splat(3e-3)).unwrap();
+    let zl = g.z_levels();
+    let s = FilterStencil::new(
+        &g,
+        &zw,
+        &zl,
+        DVec3::new(0.021, 0.013, 0.07),
+        DVec3::splat(3e-3),
+    )
+    .unwrap();
     let ones = vec![2.5; g.len()];
     assert!((s.average(&ones) - 2.5).abs() < 1e-14);
     // <spread(F), u> = F · average(u)
@@ -90,7 +99,7 @@ fn the_filter_average_is_the_adjoint_of_spreading_and_exact_for_constants() {
     let avg = s.average(&u);
     assert!((inner - force.element_sum() * avg).abs() < 1e-13);
     // non-finite input is refused, not a panic
-    assert!(FilterStencil::new(&g, &zw, DVec3::NAN, DVec3::ONE).is_none());
+    assert!(FilterStencil::new(&g, &zw, &zl, DVec3::NAN, DVec3::ONE).is_none());
 }
 
 #[test]
@@ -114,6 +123,7 @@ fn bounding_boxes_follow_the_orientation() {
 fn m5_the_torque_couple_has_no_net_force_and_the_reaction_moment() {
     let g = grid();
     let zw = g.z_quadrature_weights();
+    let zl = g.z_levels();
     for (x, t) in [
         (
             DVec3::new(0.0213, 0.0117, 0.0731),
@@ -167,10 +177,11 @@ fn the_filter_is_centred_on_the_particle_and_has_the_box_volume() {
     // the spread is the box's, wherever the particle sits relative to the nodes
     let g = grid();
     let zw = g.z_quadrature_weights();
+    let zl = g.z_levels();
     let h = DVec3::new(3.7e-3, 2.2e-3, 9e-3);
     for shift in [0.0, 0.1, 0.37, 0.5, 0.93] {
         let x = DVec3::new(0.02 + shift * g.dx(), 0.015 + 0.3 * shift * g.dy(), 0.075);
-        let s = FilterStencil::new(&g, &zw, x, h).unwrap();
+        let s = FilterStencil::new(&g, &zw, &zl, x, h).unwrap();
         let mut c = DVec3::ZERO;
         let mut var = 0.0;
         for (n, w) in s.nodes.iter().zip(&s.weights) {

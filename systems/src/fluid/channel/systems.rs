@@ -40,6 +40,8 @@ pub struct ChannelLiquid {
     pub spec: ChannelSpec,
     /// z quadrature weights of the grid [m].
     pub z_weights: Vec<f64>,
+    /// z levels of the grid [m].
+    pub z_levels: Vec<f64>,
     /// The velocity field of the previous step (for ∂u/∂t) [m/s].
     pub previous: [Vec<f64>; 3],
     /// Total force the particles put into the liquid over the last step [N].
@@ -70,6 +72,7 @@ impl ChannelLiquid {
         let previous = solver.velocity().map(<[f64]>::to_vec);
         Self {
             z_weights: grid.z_quadrature_weights(),
+            z_levels: grid.z_levels(),
             solver,
             spec,
             previous,
@@ -157,7 +160,7 @@ pub fn sample_liquid(
                 c.mobility_level = level;
             }
             c.half_widths = half;
-            let Some(st) = FilterStencil::new(grid, &lq.z_weights, x.0, half) else {
+            let Some(st) = FilterStencil::new(grid, &lq.z_weights, &lq.z_levels, x.0, half) else {
                 return;
             };
             let mut velocity = st.average3(u);
@@ -171,8 +174,8 @@ pub fn sample_liquid(
                     let mut e = DVec3::ZERO;
                     e[k] = half[k];
                     let (Some(p), Some(m)) = (
-                        FilterStencil::new(grid, &lq.z_weights, x.0 + e, half),
-                        FilterStencil::new(grid, &lq.z_weights, x.0 - e, half),
+                        FilterStencil::new(grid, &lq.z_weights, &lq.z_levels, x.0 + e, half),
+                        FilterStencil::new(grid, &lq.z_weights, &lq.z_levels, x.0 - e, half),
                     ) else {
                         continue;
                     };
@@ -283,6 +286,7 @@ pub fn advance_liquid(
         dst.copy_from_slice(src);
     }
     let zw = &lq.z_weights;
+    let zl = &lq.z_levels;
     let mut total = DVec3::ZERO;
     {
         let [fx, fy, fz] = lq.solver.body_force_mut();
@@ -291,7 +295,7 @@ pub fn advance_liquid(
         fz.fill(0.0);
         let mut out = [fx, fy, fz];
         for (x0, c) in &q {
-            let Some(st) = FilterStencil::new(&grid, zw, x0.0, c.half_widths) else {
+            let Some(st) = FilterStencil::new(&grid, zw, zl, x0.0, c.half_widths) else {
                 continue;
             };
             st.spread(-c.force, rho, &mut out);
