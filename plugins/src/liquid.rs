@@ -43,6 +43,14 @@ pub const STATE_TOPIC: &str = "/liquid/state";
 pub const STATE_SCHEMA: &str = "magsep.ChannelState";
 /// Message encoding of the solver-state messages.
 pub const STATE_ENCODING: &str = "magsep.channel_state.v1";
+/// Schema encoding of the solver-state channel: the schema data is a plain-text description.
+pub const STATE_SCHEMA_ENCODING: &str = "text/plain";
+/// The schema data of the solver-state channel.
+pub const STATE_LAYOUT: &str = "magsep.ChannelState v1: the lossless state of the channel \
+solver (magsep_systems::fluid::channel::ChannelSolver::state_bytes): a header (magic, version, \
+grid, lengths, viscosity, time step, time, steps) and the spectral wall-normal velocity, \
+wall-normal vorticity and mean profiles as little-endian f64; restore with \
+ChannelSolver::from_state_bytes.";
 
 /// The liquid's systems (see the module docs).
 #[derive(Debug, Clone, Copy, Default)]
@@ -136,7 +144,13 @@ pub fn record_liquid(
         None => {
             let added = add_grid_channel(writer, SLICE_TOPIC).and_then(|a| {
                 let b = add_grid_channel(writer, MIDPLANE_TOPIC)?;
-                let c = writer.add_channel(STATE_TOPIC, STATE_SCHEMA, "", &[], STATE_ENCODING)?;
+                let c = writer.add_channel(
+                    STATE_TOPIC,
+                    STATE_SCHEMA,
+                    STATE_SCHEMA_ENCODING,
+                    STATE_LAYOUT.as_bytes(),
+                    STATE_ENCODING,
+                )?;
                 Ok([a, b, c])
             });
             match added {

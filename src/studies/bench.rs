@@ -244,6 +244,8 @@ pub enum ChartKind {
     SpheroidModel,
     /// The two-way coupled liquid: settling against the grid, separation one-way against two-way.
     Coupling,
+    /// The channel solver: accuracy against cost, stability of the time step.
+    LiquidSolver,
 }
 
 /// `magsep bench KIND [--json] [--quick]`.
@@ -366,6 +368,9 @@ pub fn chart(what: ChartKind, out: &Path, quick: bool) -> Result<(), BenchError>
         ChartKind::Flakes => return fc::chart_flakes(out, quick),
         ChartKind::FlakeCollisions => return fc::chart_flake_collisions(out, quick),
         ChartKind::Coupling => return crate::studies::liquid::chart::chart_coupling(out, quick),
+        ChartKind::LiquidSolver => {
+            return crate::studies::liquid::solver_chart::chart_liquid_solver(out, quick);
+        }
         ChartKind::SpheroidModel => return fc::chart_spheroid_model(out, quick),
         ChartKind::SqContact => {
             std::fs::create_dir_all(out)

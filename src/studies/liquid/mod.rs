@@ -2,9 +2,11 @@
 //!
 //! * [`bench`]: `magsep bench fluid`.
 //! * [`chart`]: `magsep chart coupling`.
+//! * [`solver_chart`]: `magsep chart liquid-solver`.
 //! * [`settling`]: a single sphere settling in the coupled liquid, against the grid, with and
 //!   without the self-induced-velocity correction.
 
 pub mod bench;
 pub mod chart;
 pub mod settling;
+pub mod solver_chart;
