@@ -70,11 +70,11 @@ fn momenta(sim: &mut Simulation) -> (DVec3, DVec3) {
         .density;
     let u = l.solver.velocity();
     let mut fluid = DVec3::ZERO;
-    for k in 0..g.nz {
+    for (k, wk) in zw.iter().enumerate() {
         for i in 0..g.nx {
             for j in 0..g.ny {
                 let n = g.index(i, j, k);
-                fluid += DVec3::new(u[0][n], u[1][n], u[2][n]) * (rho * g.dx() * g.dy() * zw[k]);
+                fluid += DVec3::new(u[0][n], u[1][n], u[2][n]) * (rho * g.dx() * g.dy() * wk);
             }
         }
     }

@@ -110,31 +110,7 @@ pub(crate) fn matmul(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
 /// assert!((int - 4.0).abs() < 1e-13);
 /// ```
 pub fn clenshaw_curtis_weights(grid: &ChannelGrid) -> Vec<f64> {
-    let nz = grid.nz;
-    let n = nz - 1;
-    let nf = n as f64;
-    let mut w = vec![0.0; nz];
-    let end = if n.is_multiple_of(2) {
-        1.0 / (nf * nf - 1.0)
-    } else {
-        1.0 / (nf * nf)
-    };
-    w[0] = end;
-    w[n] = end;
-    for (k, wk) in w.iter_mut().enumerate().take(n).skip(1) {
-        let theta = PI * k as f64 / nf;
-        let mut v = 1.0;
-        for j in 1..=(n - 1) / 2 {
-            let jf = j as f64;
-            v -= 2.0 * (2.0 * jf * theta).cos() / (4.0 * jf * jf - 1.0);
-        }
-        if n.is_multiple_of(2) {
-            v -= (nf * theta).cos() / (nf * nf - 1.0);
-        }
-        *wk = 2.0 * v / nf;
-    }
-    let half = 0.5 * grid.height;
-    w.iter().map(|x| x * half).collect()
+    grid.z_quadrature_weights()
 }
 
 /// Why the wall-normal operators could not be built.

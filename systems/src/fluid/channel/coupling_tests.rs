@@ -11,7 +11,6 @@ fn grid() -> ChannelGrid {
 
 fn integrate(g: &ChannelGrid, f: &[&mut [f64]; 3], rho: f64) -> DVec3 {
     let zw = g.z_quadrature_weights();
-    let zl = g.z_levels();
     let mut s = DVec3::ZERO;
     for k in 0..g.nz {
         for i in 0..g.nx {
@@ -123,7 +122,6 @@ fn bounding_boxes_follow_the_orientation() {
 fn m5_the_torque_couple_has_no_net_force_and_the_reaction_moment() {
     let g = grid();
     let zw = g.z_quadrature_weights();
-    let zl = g.z_levels();
     for (x, t) in [
         (
             DVec3::new(0.0213, 0.0117, 0.0731),

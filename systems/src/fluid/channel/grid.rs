@@ -188,7 +188,7 @@ impl ChannelGrid {
         let n = self.nz - 1;
         let nf = n as f64;
         let scale = 0.5 * self.height;
-        let end = if n % 2 == 0 {
+        let end = if n.is_multiple_of(2) {
             1.0 / (nf * nf - 1.0)
         } else {
             1.0 / (nf * nf)
@@ -201,7 +201,7 @@ impl ChannelGrid {
                 let mf = m as f64;
                 v -= 2.0 * (2.0 * mf * theta).cos() / (4.0 * mf * mf - 1.0);
             }
-            if n % 2 == 0 {
+            if n.is_multiple_of(2) {
                 v -= (nf * theta).cos() / (nf * nf - 1.0);
             }
             *wk = 2.0 * v / nf * scale;

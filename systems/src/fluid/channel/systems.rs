@@ -300,10 +300,11 @@ pub fn advance_liquid(
             };
             st.spread(-c.force, rho, &mut out);
             total -= c.force;
-            if torque && c.torque != DVec3::ZERO {
-                if let Some(corners) = torque_couple(&grid, x0.0, c.torque) {
-                    spread_couple(&grid, zw, &corners, rho, &mut out);
-                }
+            if torque
+                && c.torque != DVec3::ZERO
+                && let Some(corners) = torque_couple(&grid, x0.0, c.torque)
+            {
+                spread_couple(&grid, zw, &corners, rho, &mut out);
             }
         }
     }
