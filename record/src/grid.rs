@@ -11,19 +11,19 @@ use glam::{DQuat, DVec3};
 use crate::writer::ChannelHandle;
 use crate::{RecordError, RecordingWriter, SCENE_FRAME_ID};
 
-/// A uniform 2-D grid of named float64 fields: `columns × rows` cells of `cell_size` [m],
-/// its corner at `origin` [m], its plane spanned by `rotation · e_x` (columns) and
+/// A uniform 2-D grid of named float64 fields: `columns × rows` cells of `cell_size` \[m\],
+/// its corner at `origin` \[m\], its plane spanned by `rotation · e_x` (columns) and
 /// `rotation · e_y` (rows). Every field has `columns · rows` values, row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridSlice<'a> {
-    /// Log time of the slice [ns] (as the frame of the same step, see
+    /// Log time of the slice \[ns\] (as the frame of the same step, see
     /// [`log_time_ns`](crate::log_time_ns)).
     pub log_time_ns: u64,
-    /// Corner of the grid [m].
+    /// Corner of the grid \[m\].
     pub origin: DVec3,
     /// Orientation of the grid plane.
     pub rotation: DQuat,
-    /// Cell size along columns and rows [m].
+    /// Cell size along columns and rows \[m\].
     pub cell_size: [f64; 2],
     /// Number of columns.
     pub columns: usize,

@@ -110,7 +110,7 @@ fn exponent(points: &[(f64, f64)]) -> f64 {
     num / den
 }
 
-/// Coupling cost per particle [s] on the 64³ grid.
+/// Coupling cost per particle \[s\] on the 64³ grid.
 fn coupling_cost(particles: usize) -> Result<f64, BenchError> {
     let s = solver(64)?;
     let g = *s.grid();

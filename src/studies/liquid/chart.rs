@@ -27,7 +27,7 @@ fn runtime(e: impl std::fmt::Display) -> BenchError {
     BenchError::Runtime(e.to_string())
 }
 
-/// (name, one-way scene, two-way scene, thesis time to e_m = 0.02 [s] where stated).
+/// (name, one-way scene, two-way scene, thesis time to e_m = 0.02 \[s\] where stated).
 const CASES: [(&str, &str, &str, Option<f64>); 4] = [
     (
         "1A",
@@ -55,7 +55,7 @@ const CASES: [(&str, &str, &str, Option<f64>); 4] = [
     ),
 ];
 
-/// The sphere channel's period [m] (4π L / 3).
+/// The sphere channel's period \[m\] (4π L / 3).
 const SIDE: &str = "0.3141592653589793";
 
 fn reduced(text: &str, quick: bool) -> String {

@@ -21,7 +21,7 @@ use serde::Serialize;
 use crate::studies::bench::BenchError;
 use crate::studies::fluid_charts::{runtime, simulation};
 
-/// Particle diameter [m].
+/// Particle diameter \[m\].
 pub const DIAMETER: f64 = 2e-3;
 /// Densities [kg/m³] and viscosity [Pa s].
 const RHO_P: f64 = 1010.0;
@@ -48,7 +48,7 @@ pub struct SettlingRow {
     pub velocity: f64,
     /// `velocity / v_St`.
     pub ratio: f64,
-    /// Wall time of the run [s].
+    /// Wall time of the run \[s\].
     pub wall_time_s: f64,
 }
 

@@ -21,14 +21,14 @@
 //!   any point (spec M5). A host cell touching a wall is moved one level inwards; the moment
 //!   is unchanged because the forces sum to zero.
 //!
-//! Units: forces [N], torques [N m], positions [m]; the body force handed to the solver is
+//! Units: forces \[N\], torques \[N m\], positions \[m\]; the body force handed to the solver is
 //! per unit mass [m/s²] (divide the force density [N/m³] by ρ_f).
 
 use glam::{DMat3, DQuat, DVec3};
 
 use super::grid::ChannelGrid;
 
-/// Half-widths [m] of the axis-aligned bounding box of a spheroid with semi-axes
+/// Half-widths \[m\] of the axis-aligned bounding box of a spheroid with semi-axes
 /// `(a, a, c)` (body z the symmetry axis) rotated by `q` (body → lab); a sphere has `a = c`.
 ///
 /// ```
@@ -125,7 +125,7 @@ fn level_weights(levels: &[f64], z: f64, half: f64) -> Vec<(usize, f64)> {
 }
 
 impl FilterStencil {
-    /// The stencil of a box of half-widths `half` [m] centred at `centre` [m] (x and y are
+    /// The stencil of a box of half-widths `half` \[m\] centred at `centre` \[m\] (x and y are
     /// wrapped; along z only interior levels take part, a box reaching past them is clipped,
     /// and a box outside the interior falls back to the nearest interior level). `zw` are the
     /// grid's [`ChannelGrid::z_quadrature_weights`] and `levels` its [`ChannelGrid::z_levels`]
@@ -190,7 +190,7 @@ impl FilterStencil {
         )
     }
 
-    /// Add the force density `P·force/ρ_f` [m/s²] of `force` [N] to the body-force fields.
+    /// Add the force density `P·force/ρ_f` [m/s²] of `force` \[N\] to the body-force fields.
     pub fn spread(&self, force: DVec3, fluid_density: f64, out: &mut [&mut [f64]; 3]) {
         let a = force / fluid_density;
         for (n, p) in self.nodes.iter().zip(&self.densities) {
@@ -201,19 +201,19 @@ impl FilterStencil {
     }
 }
 
-/// One of the eight point forces of a torque couple: node index, node position [m] (unwrapped,
-/// next to the particle) and force [N].
+/// One of the eight point forces of a torque couple: node index, node position \[m\] (unwrapped,
+/// next to the particle) and force \[N\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CornerForce {
     /// Flat node index.
     pub node: usize,
-    /// Node position [m], unwrapped to the particle's side of the periodic cell.
+    /// Node position \[m\], unwrapped to the particle's side of the periodic cell.
     pub position: DVec3,
-    /// Force [N] (the node's force density times its volume).
+    /// Force \[N\] (the node's force density times its volume).
     pub force: DVec3,
 }
 
-/// The eight corner forces that apply the reaction `−torque` [N m] of a particle at `centre`
+/// The eight corner forces that apply the reaction `−torque` \[N m\] of a particle at `centre`
 /// to the liquid (eq. 4.23): host cell `[x_i, x_i+1] × [y_j, y_j+1] × [z_k, z_k+1]` (moved off
 /// the walls), corner `(a, b, c) ∈ {0, 1}³`, `s = 2·index − 1`:
 /// `F = ⅛ (s_b T_z/δ_y − s_c T_y/δ_z, s_c T_x/δ_z − s_a T_z/δ_x, s_a T_y/δ_x − s_b T_x/δ_y)`.

@@ -172,7 +172,7 @@ impl ChannelGrid {
             .collect()
     }
 
-    /// Clenshaw-Curtis quadrature weights [m] of the z levels: `Σ_k w_k f(z_k)` is exact for
+    /// Clenshaw-Curtis quadrature weights \[m\] of the z levels: `Σ_k w_k f(z_k)` is exact for
     /// polynomials of degree ≤ nz − 1 on `[0, height]` (all weights are positive). Multiplied
     /// by `dx·dy` they are the node volumes of the discrete integrals (momentum budgets,
     /// filter normalisation).

@@ -103,7 +103,7 @@ pub struct GrowthRun {
     pub reference: f64,
     /// `|rate − reference| / reference`.
     pub relative_error: f64,
-    /// Wall time of the time stepping [s].
+    /// Wall time of the time stepping \[s\].
     pub wall_time_s: f64,
 }
 

@@ -31,7 +31,7 @@ use crate::field::demag::gauss_legendre_01;
 /// Face rule points per direction (the face integrands are smooth: 24 points give ~1e-12).
 const FACE_POINTS: usize = 24;
 
-/// Diagonal of the self-mobility `M` [m/(N s)] of a top-hat box of half-widths `half` [m] in a
+/// Diagonal of the self-mobility `M` [m/(N s)] of a top-hat box of half-widths `half` \[m\] in a
 /// liquid of dynamic viscosity `viscosity` [Pa s] (see the module docs). Zero for a
 /// degenerate box or a non-positive viscosity.
 ///
@@ -78,7 +78,7 @@ pub fn self_mobility(half: DVec3, viscosity: f64) -> DVec3 {
 }
 
 /// The steady Stokes velocity [m/s] at the centre of a box of half-widths `half` over which
-/// `force` [N] is spread uniformly (Oseen tensor integrated over the box; the classical value
+/// `force` \[N\] is spread uniformly (Oseen tensor integrated over the box; the classical value
 /// for a cube of side σ is `∫ 1/r dV = 2.38008 σ²`). Used to check [`self_mobility`]'s
 /// quadrature and for the point value of the regularised Stokeslet.
 pub fn centre_velocity(half: DVec3, viscosity: f64, force: DVec3) -> DVec3 {

@@ -38,19 +38,19 @@ pub struct ChannelLiquid {
     pub solver: ChannelSolver,
     /// The scene's options.
     pub spec: ChannelSpec,
-    /// z quadrature weights of the grid [m].
+    /// z quadrature weights of the grid \[m\].
     pub z_weights: Vec<f64>,
-    /// z levels of the grid [m].
+    /// z levels of the grid \[m\].
     pub z_levels: Vec<f64>,
     /// The velocity field of the previous step (for ∂u/∂t) [m/s].
     pub previous: [Vec<f64>; 3],
-    /// Total force the particles put into the liquid over the last step [N].
+    /// Total force the particles put into the liquid over the last step \[N\].
     pub last_feedback: DVec3,
 }
 
 impl ChannelLiquid {
     /// The liquid at rest for `spec` on `grid`, with kinematic viscosity `nu` [m²/s] and time
-    /// step `dt` [s].
+    /// step `dt` \[s\].
     ///
     /// # Errors
     /// The solver's message when it rejects the parameters.
@@ -89,7 +89,7 @@ impl ChannelLiquid {
 /// What a particle exchanges with the liquid (a component).
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
 pub struct LiquidCoupling {
-    /// Filter half-widths [m] at the last sampling (the axis-aligned bounding box).
+    /// Filter half-widths \[m\] at the last sampling (the axis-aligned bounding box).
     pub half_widths: DVec3,
     /// Diagonal self-mobility of the filter [m/(N s)] (for the self-induced correction).
     pub mobility: DVec3,
@@ -99,13 +99,13 @@ pub struct LiquidCoupling {
     pub step_start_velocity: DVec3,
     /// Angular velocity at the start of the step [rad/s].
     pub step_start_spin: DVec3,
-    /// The hydrodynamic force F_2w on the particle over the last step [N].
+    /// The hydrodynamic force F_2w on the particle over the last step \[N\].
     pub force: DVec3,
-    /// The hydrodynamic torque T_2w on the particle over the last step [N m].
+    /// The hydrodynamic torque T_2w on the particle over the last step \[N m\].
     pub torque: DVec3,
 }
 
-/// Half-widths of a particle's filter box [m].
+/// Half-widths of a particle's filter box \[m\].
 fn half_widths(body: &InertialBody, spheroid: Option<&SpheroidFluid>, o: &Orientation) -> DVec3 {
     match spheroid {
         Some(s) => bounding_half_widths(s.equatorial_radius, s.polar_radius, o.0),
@@ -113,7 +113,7 @@ fn half_widths(body: &InertialBody, spheroid: Option<&SpheroidFluid>, o: &Orient
     }
 }
 
-/// The half-widths [m] of the box whose unbounded Stokes response the self-induced correction
+/// The half-widths \[m\] of the box whose unbounded Stokes response the self-induced correction
 /// subtracts: the filter box convolved with the grid's hat functions has the variance
 /// `h²/3 + Δ²/6` per axis, which a box of half-width `sqrt(h² + Δ²/2)` matches (Δ the local
 /// spacing; along z the gap to the next level).
