@@ -190,7 +190,7 @@ fn v6_separation_error_at_three_seconds_full_size() {
     // about 0.0072 / 0.0118 / 0.0236: spheres within the ±30 % band, the 1:2 flakes 35 % low
     // and the 1:10 flakes 8 times low, because in a liquid at rest a flake released
     // broadside stays broadside (no flow-induced rotation: the thesis's two-way torque
-    // coupling is what disperses them, issue 15). The ordering holds.
+    // coupling is what disperses them, see the coupled scenes). The ordering holds.
     let e: Vec<f64> = [1.0, 0.5, 0.1]
         .iter()
         .map(|&w| separation_at_end(&run(&many(w, 0.01, 3.0)).1))

@@ -1,6 +1,6 @@
 //! `magsep chart separation --out DIR [--quick]`: the many-particle density separation runs of
 //! thesis 002, §2.5.3 (figs. 2.16, 2.18), from the shipped scenes `scenes/mds_case*.toml`
-//! (compiled in), all one-way coupled (magsep has no fluid solver yet, so the thesis's case
+//! (compiled in), all one-way coupled (the two-way coupled runs are `magsep chart coupling`; here the thesis's case
 //! 1A runs as its case 1C).
 //!
 //! Full mode runs the scenes as shipped (table 2.4 particle counts, 5 s); `--quick` shrinks the
