@@ -3,7 +3,6 @@
 //! `volume_fraction`.
 
 use glam::DVec3;
-use magsep_systems::fluid::channel::config::LiquidSolver;
 use magsep_systems::fluid::config::HistoryChoice;
 use magsep_systems::fluid::flow::FlowModel;
 
@@ -66,7 +65,7 @@ fn flow_checks(flow: &FlowModel, errors: &mut Vec<SceneError>) {
 
 /// The simulated liquid: its options, a channel container, and no prescribed flow beside it.
 fn solver_checks(pf: &ParticleFluidScene, errors: &mut Vec<SceneError>) {
-    let Some(LiquidSolver::Channel(spec)) = &pf.liquid.solver else {
+    let Some(spec) = &pf.liquid.solver else {
         return;
     };
     for (key, message) in spec.problems() {

@@ -189,7 +189,7 @@ impl ParticleFluidConfig {
     /// not one-way).
     pub fn channel(&self) -> Option<ChannelSpec> {
         match self.solver {
-            Some(LiquidSolver::Channel(c)) if c.coupling.solves_liquid() => Some(c),
+            Some(c) if c.coupling.solves_liquid() => Some(c),
             _ => None,
         }
     }

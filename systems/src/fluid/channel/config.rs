@@ -33,19 +33,25 @@ fn yes() -> bool {
     true
 }
 
-/// A solver for the liquid.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum LiquidSolver {
-    /// The pseudo-spectral channel solver ([`super::solver`]): periodic in x and y, no-slip
-    /// walls at z = 0 and z = height (needs `[container] kind = "channel"`).
-    Channel(ChannelSpec),
+/// Which solver simulates the liquid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverKind {
+    /// The pseudo-spectral channel solver ([`super::stepper::ChannelSolver`]): periodic in x
+    /// and y, no-slip walls at z = 0 and z = height (needs `[container] kind = "channel"`).
+    Channel,
 }
+
+/// The scene's liquid solver (`[liquid] solver`). A plain struct with a `kind` field rather
+/// than a tagged enum, so that every error names its innermost key.
+pub type LiquidSolver = ChannelSpec;
 
 /// Options of the channel solver.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelSpec {
+    /// The solver: `"channel"`.
+    pub kind: SolverKind,
     /// Grid `[nx, ny, nz]`: Fourier points along x and y (even, ≥ 4) and Chebyshev-Gauss-Lobatto
     /// points along z (≥ 5, walls included). The thesis used 256 × 256 × 129.
     pub grid: [usize; 3],
