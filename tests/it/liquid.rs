@@ -170,14 +170,14 @@ fn a_settling_sphere_approaches_stokes_with_the_self_induced_correction() {
 }
 
 #[test]
-#[ignore = "release tier: settling convergence up to d/Δ = 4 (about a minute)"]
+#[ignore = "release tier: settling convergence up to d/Δ = 3 (about a minute)"]
 fn settling_converges_as_the_grid_resolves_the_filter() {
-    let rows: Vec<_> = [8, 16, 32, 48, 64]
+    let rows: Vec<_> = [16, 32, 48]
         .iter()
         .map(|&n| {
             (
-                settle(n, 16.0, false, 0.3).unwrap(),
-                settle(n, 16.0, true, 0.3).unwrap(),
+                settle(n, 16.0, false, 0.2).unwrap(),
+                settle(n, 16.0, true, 0.2).unwrap(),
             )
         })
         .collect();
@@ -187,12 +187,12 @@ fn settling_converges_as_the_grid_resolves_the_filter() {
             raw.diameter_over_spacing, raw.ratio, fixed.ratio
         );
     }
-    // corrected: converged to within 2 % between the two finest grids, within the confinement
-    // hindrance of Stokes; uncorrected: far off and drifting
-    let (a, b) = (rows[3].1.ratio, rows[4].1.ratio);
+    // corrected: converged to within 2 % between d/Δ = 2 and 3, within the confinement
+    // hindrance of Stokes; uncorrected: far off and still drifting (the chart goes to d/Δ = 4)
+    let (a, b) = (rows[1].1.ratio, rows[2].1.ratio);
     assert!((a - b).abs() < 0.02, "{a} {b}");
     assert!((0.85..1.0).contains(&b), "{b}");
-    assert!(rows[4].0.ratio > 1.5);
+    assert!(rows[2].0.ratio > 1.5 && rows[2].0.ratio > rows[1].0.ratio);
 }
 
 #[test]
