@@ -31,10 +31,7 @@ use magsep_systems::fluid::channel::solver::ChannelParams;
 use magsep_systems::fluid::channel::stepper::ChannelSolver;
 
 use crate::studies::bench::{BenchError, emit};
-
-fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
-}
+use crate::studies::fluid_charts::runtime;
 
 /// A solver on an `n × n × (n+1)` grid of the thesis's channel proportions, with a random
 /// smooth initial field.

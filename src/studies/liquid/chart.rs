@@ -20,12 +20,9 @@ use serde_json::{Value, json};
 use super::settling::{SettlingRow, settle};
 use crate::chart::{Chart, Figure, LegendPosition, Line, Series, Style, write_svg};
 use crate::studies::bench::BenchError;
+use crate::studies::fluid_charts::runtime;
 use crate::studies::fluid_charts::separation::run_case;
 use magsep_systems::fluid::observe::SeparationCurve;
-
-fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
-}
 
 /// (name, one-way scene, two-way scene, thesis time to e_m = 0.02 \[s\] where stated).
 const CASES: [(&str, &str, &str, Option<f64>); 4] = [

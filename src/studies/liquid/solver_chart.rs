@@ -18,13 +18,10 @@ use serde_json::json;
 
 use crate::chart::{Chart, Figure, LegendPosition, Series, Style, write_svg};
 use crate::studies::bench::BenchError;
+use crate::studies::fluid_charts::runtime;
 use magsep_systems::fluid::channel::grid::ChannelGrid;
 use magsep_systems::fluid::channel::orr_sommerfeld::{orr_sommerfeld, ts_growth};
 use magsep_systems::fluid::channel::{ChannelParams, ChannelSolver};
-
-fn runtime(e: impl std::fmt::Display) -> BenchError {
-    BenchError::Runtime(e.to_string())
-}
 
 /// Energy growth and CFL of a Poiseuille flow (Re = 7500) carrying a 1 % Tollmien-Schlichting
 /// wave on a 16 × 4 × 33 grid after `t_end` with step `dt`: (CFL, E(t)/E(0) or NaN).

@@ -31,6 +31,29 @@ use crate::field::demag::gauss_legendre_01;
 /// Face rule points per direction (the face integrands are smooth: 24 points give ~1e-12).
 const FACE_POINTS: usize = 24;
 
+/// `Σ_faces ∫_face w(s, axis) (I + s s/r²)/r dA` over the three far faces of the octant box
+/// `[0, e]³` (face `axis` at `s_axis = e_axis`), by an n × n Gauss rule: the diagonal of the
+/// pyramid integrals of the Oseen tensor's homogeneous kernel, weighted by `w`.
+fn face_sum(e: DVec3, w: impl Fn(DVec3, usize) -> f64) -> DVec3 {
+    let face = gauss_legendre_01(FACE_POINTS);
+    let mut sum = DVec3::ZERO;
+    for axis in 0..3 {
+        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
+        for &(u, wu) in &face {
+            for &(v, wv) in &face {
+                let mut s = DVec3::ZERO;
+                s[axis] = e[axis];
+                s[p] = u * e[p];
+                s[q] = v * e[q];
+                let r = s.length();
+                let g = (DVec3::ONE + s * s / (r * r)) / r;
+                sum += g * (w(s, axis) * wu * wv * e[p] * e[q]);
+            }
+        }
+    }
+    sum
+}
+
 /// Diagonal of the self-mobility `M` [m/(N s)] of a top-hat box of half-widths `half` \[m\] in a
 /// liquid of dynamic viscosity `viscosity` [Pa s] (see the module docs). Zero for a
 /// degenerate box or a non-positive viscosity.
@@ -47,32 +70,19 @@ pub fn self_mobility(half: DVec3, viscosity: f64) -> DVec3 {
         return DVec3::ZERO;
     }
     let l = 2.0 * half;
-    let face = gauss_legendre_01(FACE_POINTS);
     let ray = gauss_legendre_01(3);
-    let mut sum = DVec3::ZERO;
-    for axis in 0..3 {
-        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for &(u, wu) in &face {
-            for &(v, wv) in &face {
-                let mut s = DVec3::ZERO;
-                s[axis] = l[axis];
-                s[p] = u * l[p];
-                s[q] = v * l[q];
-                let r = s.length();
-                // g(s) = (1 + s_i²/r²)/r for each diagonal component
-                let g = (DVec3::ONE + s * s / (r * r)) / r;
-                // ∫_0^1 t A(t s) dt (a quartic in t: 3-point Gauss is exact)
-                let radial: f64 = ray
-                    .iter()
-                    .map(|&(t, wt)| {
-                        let a = (l - t * s).max(DVec3::ZERO);
-                        wt * t * a.x * a.y * a.z
-                    })
-                    .sum();
-                sum += g * (radial * wu * wv * l[p] * l[q] * l[axis]);
-            }
-        }
-    }
+    // ∫_0^1 t A(t s) dt along the ray (a quartic in t: 3-point Gauss is exact), times the
+    // pyramid's height l_axis
+    let sum = face_sum(l, |s, axis| {
+        let radial: f64 = ray
+            .iter()
+            .map(|&(t, wt)| {
+                let a = (l - t * s).max(DVec3::ZERO);
+                wt * t * a.x * a.y * a.z
+            })
+            .sum();
+        radial * l[axis]
+    });
     let volume = l.x * l.y * l.z;
     sum * 8.0 / (8.0 * PI * viscosity * volume * volume)
 }
@@ -85,23 +95,8 @@ pub fn centre_velocity(half: DVec3, viscosity: f64, force: DVec3) -> DVec3 {
     if !(half.min_element() > 0.0 && half.is_finite() && viscosity > 0.0) {
         return DVec3::ZERO;
     }
-    let face = gauss_legendre_01(FACE_POINTS);
-    let mut sum = DVec3::ZERO;
-    for axis in 0..3 {
-        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for &(u, wu) in &face {
-            for &(v, wv) in &face {
-                let mut s = DVec3::ZERO;
-                s[axis] = half[axis];
-                s[p] = u * half[p];
-                s[q] = v * half[q];
-                let r = s.length();
-                // pyramid over the face, homogeneous degree −1: ∫ = (h/2) ∫_face g dA
-                let g = (DVec3::ONE + s * s / (r * r)) / r;
-                sum += g * (0.5 * half[axis] * wu * wv * half[p] * half[q]);
-            }
-        }
-    }
+    // pyramid over each face, homogeneous degree −1: ∫ = (h/2) ∫_face g dA
+    let sum = face_sum(half, |_, axis| 0.5 * half[axis]);
     let volume = 8.0 * half.x * half.y * half.z;
     // 8 octants; u = F/(8πμV) ∫ (I/r + rr/r³)
     force * sum * 8.0 / (8.0 * PI * viscosity * volume)
