@@ -15,7 +15,8 @@
 //! horizontal x-y slice at mid-height (`w`, the particle-induced wall-normal velocity) as
 //! `foxglove.Grid` messages, resampled to uniform rows for display; and the solver's complete
 //! state, lossless (`magsep.ChannelState`, raw little-endian bytes, see
-//! `ChannelSolver::state_bytes`), from which a coupled run can restart.
+//! `ChannelSolver::state_bytes`), from which a coupled run can restart; with `step_every > 1`
+//! the state is written only at the recorded steps that complete a liquid step.
 
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
@@ -202,14 +203,15 @@ pub fn record_liquid(
         rows: grid.ny,
         fields: &[("w", &mid)],
     };
-    let state = liquid.solver.state_bytes();
+    // the state only where no particle step is half-way into the next liquid step
+    let state = (liquid.pending == 0).then(|| liquid.solver.state_bytes());
     let result = vertical.encode().and_then(|a| {
         let b = horizontal.encode()?;
-        writer.write_messages(&[
-            (handles[0], log_time_ns, &a),
-            (handles[1], log_time_ns, &b),
-            (handles[2], log_time_ns, &state),
-        ])
+        let mut messages = vec![(handles[0], log_time_ns, &a[..]), (handles[1], log_time_ns, &b[..])];
+        if let Some(s) = &state {
+            messages.push((handles[2], log_time_ns, &s[..]));
+        }
+        writer.write_messages(&messages)
     });
     if let Err(e) = result {
         recorder.fail(format!("writing the liquid at step {}: {e}", clock.step));

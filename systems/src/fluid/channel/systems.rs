@@ -44,13 +44,18 @@ pub struct ChannelLiquid {
     pub z_levels: Vec<f64>,
     /// The velocity field of the previous step (for ∂u/∂t) [m/s].
     pub previous: [Vec<f64>; 3],
-    /// Total force the particles put into the liquid over the last step \[N\].
+    /// Total force the particles put into the liquid, averaged over the last liquid step \[N\].
     pub last_feedback: DVec3,
+    /// Particle steps accumulated into the body force since the last liquid step (below
+    /// `spec.step_every`).
+    pub pending: u32,
+    /// The force being accumulated for the next liquid step \[N\].
+    accumulated: DVec3,
 }
 
 impl ChannelLiquid {
-    /// The liquid at rest for `spec` on `grid`, with kinematic viscosity `nu` [m²/s] and time
-    /// step `dt` \[s\].
+    /// The liquid at rest for `spec` on `grid`, with kinematic viscosity `nu` [m²/s], advanced
+    /// every `spec.step_every` particle steps of `dt` \[s\].
     ///
     /// # Errors
     /// The solver's message when it rejects the parameters.
@@ -58,7 +63,7 @@ impl ChannelLiquid {
         let params = super::solver::ChannelParams {
             grid,
             viscosity: nu,
-            dt,
+            dt: dt * f64::from(spec.step_every.max(1)),
             dealias: spec.dealias,
             mean_pressure_gradient: [0.0; 2],
         };
@@ -77,6 +82,8 @@ impl ChannelLiquid {
             spec,
             previous,
             last_feedback: DVec3::ZERO,
+            pending: 0,
+            accumulated: DVec3::ZERO,
         }
     }
 
@@ -147,7 +154,8 @@ pub fn sample_liquid(
         &lq.previous[1][..],
         &lq.previous[2][..],
     ];
-    let dt = cfg.dt;
+    // the field changes once per liquid step
+    let dt = lq.solver.params().dt;
     let mu = cfg.liquid.viscosity;
     let accel = cfg.terms.undisturbed_flow || cfg.terms.added_mass;
     let correct = lq.spec.self_induced_correction;
@@ -271,10 +279,12 @@ pub fn compute_feedback(
     );
 }
 
-/// Spread the reactions onto the grid and advance the liquid one step (`Integrate`).
+/// Spread the reactions onto the grid and advance the liquid (`Integrate`): every particle
+/// step adds its reactions, weighted `1/step_every`, to the body force; every `step_every`-th
+/// step advances the liquid by one liquid step with their average.
 pub fn advance_liquid(
-    cfg: Res<ParticleFluidConfig>,
     mut liquid: ResMut<ChannelLiquid>,
+    cfg: Res<ParticleFluidConfig>,
     mut health: ResMut<Health>,
     q: Query<(&StepStart, &LiquidCoupling)>,
 ) {
@@ -282,33 +292,42 @@ pub fn advance_liquid(
     let grid = *lq.solver.grid();
     let rho = cfg.liquid.density;
     let torque = lq.spec.coupling.feeds_torque();
-    for (dst, src) in lq.previous.iter_mut().zip(lq.solver.velocity()) {
-        dst.copy_from_slice(src);
-    }
+    let every = lq.spec.step_every.max(1);
+    let weight = 1.0 / f64::from(every);
     let zw = &lq.z_weights;
     let zl = &lq.z_levels;
-    let mut total = DVec3::ZERO;
     {
         let [fx, fy, fz] = lq.solver.body_force_mut();
-        fx.fill(0.0);
-        fy.fill(0.0);
-        fz.fill(0.0);
+        if lq.pending == 0 {
+            fx.fill(0.0);
+            fy.fill(0.0);
+            fz.fill(0.0);
+            lq.accumulated = DVec3::ZERO;
+        }
         let mut out = [fx, fy, fz];
         for (x0, c) in &q {
             let Some(st) = FilterStencil::new(&grid, zw, zl, x0.0, c.half_widths) else {
                 continue;
             };
-            st.spread(-c.force, rho, &mut out);
-            total -= c.force;
+            st.spread(-c.force * weight, rho, &mut out);
+            lq.accumulated -= c.force * weight;
             if torque
                 && c.torque != DVec3::ZERO
-                && let Some(corners) = torque_couple(&grid, x0.0, c.torque)
+                && let Some(corners) = torque_couple(&grid, x0.0, c.torque * weight)
             {
                 spread_couple(&grid, zw, &corners, rho, &mut out);
             }
         }
     }
-    lq.last_feedback = total;
+    lq.pending += 1;
+    if lq.pending < every {
+        return;
+    }
+    lq.pending = 0;
+    lq.last_feedback = lq.accumulated;
+    for (dst, src) in lq.previous.iter_mut().zip(lq.solver.velocity()) {
+        dst.copy_from_slice(src);
+    }
     lq.solver.step();
     let u = lq.solver.velocity();
     if u.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
