@@ -207,7 +207,10 @@ pub fn record_liquid(
     let state = (liquid.pending == 0).then(|| liquid.solver.state_bytes());
     let result = vertical.encode().and_then(|a| {
         let b = horizontal.encode()?;
-        let mut messages = vec![(handles[0], log_time_ns, &a[..]), (handles[1], log_time_ns, &b[..])];
+        let mut messages = vec![
+            (handles[0], log_time_ns, &a[..]),
+            (handles[1], log_time_ns, &b[..]),
+        ];
         if let Some(s) = &state {
             messages.push((handles[2], log_time_ns, &s[..]));
         }

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
-use magsep_systems::field::{CylinderSource, EXACT};
+use magsep_systems::field::{CylinderSource, EXACT, FieldValue, MU0};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -42,8 +42,8 @@ pub fn bench_points(n: usize, seed: u64) -> Vec<DVec3> {
         .collect()
 }
 
-/// Points per second of `f` over `points` on `threads` threads (best of `reps`).
-fn rate(points: &[DVec3], threads: usize, reps: usize, f: &(dyn Fn(DVec3) -> f64 + Sync)) -> f64 {
+/// Best-of-`reps` points per second of `run` (which evaluates all `points`) on `threads` threads.
+fn rate(n: usize, threads: usize, reps: usize, run: &(dyn Fn() -> f64 + Sync)) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -51,49 +51,139 @@ fn rate(points: &[DVec3], threads: usize, reps: usize, f: &(dyn Fn(DVec3) -> f64
     let mut best = f64::INFINITY;
     for _ in 0..reps {
         let t = Instant::now();
-        let s: f64 = pool.install(|| {
-            points
-                .par_chunks(4096)
-                .map(|c| c.iter().map(|&p| f(black_box(p))).sum::<f64>())
-                .sum()
-        });
-        black_box(s);
+        black_box(pool.install(run));
         best = best.min(t.elapsed().as_secs_f64());
     }
-    points.len() as f64 / best
+    n as f64 / best
 }
 
-/// `magsep bench field [--json] [--quick]`: points per second, one thread and all threads.
+/// `B` \[T\] of `src` at every point through [`CylinderSource::field_batch`] (in parallel
+/// chunks).
+fn field_map(src: &CylinderSource, points: &[DVec3], out: &mut [FieldValue]) {
+    out.par_chunks_mut(4096)
+        .zip(points.par_chunks(4096))
+        .for_each(|(o, p)| src.field_batch(p, EXACT, o));
+}
+
+/// Best-of-`reps` points per second of [`field_map`] on `threads` threads, and the checksum.
+fn timed_map(
+    src: &CylinderSource,
+    points: &[DVec3],
+    threads: usize,
+    reps: usize,
+    out: &mut [FieldValue],
+) -> (f64, f64) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    let mut best = f64::INFINITY;
+    for _ in 0..reps {
+        let t = Instant::now();
+        pool.install(|| field_map(src, points, out));
+        black_box(&out);
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    // the anchor's checksum: Σ|B| over the finite values, outside the timed region
+    let checksum = out[..points.len()]
+        .iter()
+        .map(|f| f.b.length())
+        .filter(|v| v.is_finite())
+        .sum();
+    (points.len() as f64 / best, checksum)
+}
+
+/// SplitMix64, as the anchor benchmark's README defines it (its observer points).
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// The anchor's point set: `n` points uniform in `[-3, 3]³` from SplitMix64 seeded with 42
+/// (x, y, z drawn in that order per point).
+pub fn anchor_points(n: usize) -> Vec<DVec3> {
+    let mut rng = SplitMix64(42);
+    (0..n)
+        .map(|_| {
+            let x = -3.0 + 6.0 * rng.unit();
+            let y = -3.0 + 6.0 * rng.unit();
+            let z = -3.0 + 6.0 * rng.unit();
+            DVec3::new(x, y, z)
+        })
+        .collect()
+}
+
+/// The anchor's cases: name and polarisation μ0 M \[T\] of a cylinder of radius 1 and half
+/// height 1 at the origin, axis z.
+pub fn anchor_cases() -> Vec<(&'static str, DVec3)> {
+    vec![
+        ("axial", DVec3::Z),
+        ("diametral", DVec3::X),
+        ("oblique", DVec3::new(0.6, 0.0, 0.8)),
+    ]
+}
+
+/// `magsep bench field [--json] [--quick]`: points per second, one thread and all threads, of
+/// the field map of one fibre (L/D = 5, the `field` rows) and of the anchor benchmark's
+/// cylinder and points (`field_anchor` rows, with the anchor's checksum `Σ|B|` \[T\]), and of
+/// the gradient.
 ///
 /// # Errors
-/// Never at present (kept for symmetry with the other benchmarks).
+/// When stdout fails.
 pub fn bench_field(as_json: bool, quick: bool) -> Result<(), BenchError> {
     let n = if quick { 100_000 } else { 1_000_000 };
-    let reps = if quick { 1 } else { 3 };
-    let points = bench_points(n, 7);
+    let reps = if quick { 1 } else { 5 };
     let all = rayon::current_num_threads();
     let mut rows = Vec::new();
     let mut threads_list = vec![1];
     if all > 1 {
         threads_list.push(all);
     }
+    let mut out = vec![FieldValue::default(); n];
+    let anchor = anchor_points(n);
+    for (case, pol) in anchor_cases() {
+        let src = CylinderSource::new(DVec3::ZERO, DVec3::Z, 1.0, 1.0, pol / MU0);
+        for &threads in &threads_list {
+            let (pps, checksum) = timed_map(&src, &anchor, threads, reps, &mut out);
+            emit(
+                &mut rows,
+                as_json,
+                json!({"name": "field_anchor", "case": case, "threads": threads, "points": n, "points_per_s": pps, "checksum": checksum}),
+            )?;
+        }
+    }
+    let points = bench_points(n, 7);
     for (case, dir) in cases() {
         let src = CylinderSource::new(DVec3::ZERO, DVec3::Z, RADIUS, HALF_LENGTH, dir * 1e6);
         for &threads in &threads_list {
-            let field = |p: DVec3| src.field(p, EXACT).b.x;
-            let pps = rate(&points, threads, reps, &field);
+            let (pps, _) = timed_map(&src, &points, threads, reps, &mut out);
             emit(
                 &mut rows,
                 as_json,
                 json!({"name": "field", "case": case, "threads": threads, "points": n, "points_per_s": pps}),
             )?;
         }
-        let grad = |p: DVec3| src.field_gradient(p, EXACT).grad_b.x_axis.x;
-        let pps = rate(&points[..n / 4], 1, reps, &grad);
+        let m = n / 4;
+        let grad = &points[..m];
+        let pps = rate(m, 1, reps, &|| {
+            grad.iter()
+                .map(|&p| src.field_gradient(black_box(p), EXACT).grad_b.x_axis.x)
+                .sum()
+        });
         emit(
             &mut rows,
             as_json,
-            json!({"name": "field_gradient", "case": case, "threads": 1, "points": n / 4, "points_per_s": pps}),
+            json!({"name": "field_gradient", "case": case, "threads": 1, "points": m, "points_per_s": pps}),
         )?;
     }
     Ok(())

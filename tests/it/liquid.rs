@@ -125,7 +125,10 @@ fn the_coupled_momentum_budget_closes() {
     // most two particle steps): within 1 % of the velocity lost, but not bit-identical
     let lost = finals[1].length();
     let diff = (finals[2] - finals[1]).length();
-    assert!(diff > 0.0 && diff < 0.01 * lost, "diff {diff:e}, lost {lost:e}");
+    assert!(
+        diff > 0.0 && diff < 0.01 * lost,
+        "diff {diff:e}, lost {lost:e}"
+    );
 }
 
 #[test]

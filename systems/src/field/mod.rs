@@ -2,6 +2,7 @@
 //! magnetised finite cylinders (thesis 000, ch. 5), demagnetising factors and the
 //! Stoner-Wohlfarth magnetisation direction (D-000-4 in docs/references.md).
 //!
+//! * [`batch`]: the closed form on four points at a time (vector lanes).
 //! * [`cel`]: Bulirsch's generalised complete elliptic integral (fused for the cylinder).
 //! * [`cylinder`]: the body-frame kernel (closed form, near-axis expansion).
 //! * [`multipole`]: the exterior multipole expansion with its error bound.
@@ -22,6 +23,7 @@
 //! assert!((f.b.z - MU0 * m).abs() < 1e-6 * MU0 * m);
 //! ```
 
+pub mod batch;
 pub mod cel;
 pub mod cylinder;
 pub mod demag;
@@ -33,5 +35,6 @@ pub mod source;
 pub use force::{MomentModel, dipole_force};
 pub use real::{Dual3, Real};
 pub use source::{
-    CylinderSource, EXACT, FieldGradient, FieldValue, MU0, total_field, total_field_gradient,
+    CylinderSource, EXACT, FieldGradient, FieldValue, MU0, total_field, total_field_batch,
+    total_field_gradient,
 };
