@@ -70,7 +70,7 @@ pub fn overlap_forces(
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
     let radii = sphere_radii(state);
-    overlap_forces_with(state, list, radii.as_deref(), force, torque)
+    overlap_forces_with(state, list, radii.as_deref(), true, force, torque)
 }
 
 /// [`overlap_forces`] by the generic contact route for every body (the reference of the
@@ -81,14 +81,16 @@ pub fn overlap_forces_generic(
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
-    overlap_forces_with(state, list, None, force, torque)
+    overlap_forces_with(state, list, None, true, force, torque)
 }
 
-/// [`overlap_forces`] with the sphere radii known (`Some` only when every body is a sphere).
+/// [`overlap_forces`] with the sphere radii known (`Some` only when every body is a sphere);
+/// the sphere kernel sums the pairs' energy only `with_energy`.
 fn overlap_forces_with(
     state: &PackingState,
     list: &mut NeighbourList,
     sphere_radii: Option<&[f64]>,
+    with_energy: bool,
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
@@ -98,7 +100,7 @@ fn overlap_forces_with(
     let mut energy = 0.0;
     let mut fallbacks = 0;
     if let Some(radii) = sphere_radii {
-        (max_overlap, energy) = sphere_pair_forces(state, radii, list.unique(), force);
+        (max_overlap, energy) = sphere_pair_forces(state, radii, list.unique(), force, with_energy);
     } else {
         for idx in 0..list.unique().len() {
             let p = list.unique()[idx];
@@ -196,8 +198,14 @@ pub fn remove_overlaps_fire_with(
     let mut window_energy = f64::INFINITY;
     loop {
         list.ensure(state);
-        let (max_overlap, energy, fb) =
-            overlap_forces_with(state, list, radii.as_deref(), &mut f, &mut t);
+        let (max_overlap, energy, fb) = overlap_forces_with(
+            state,
+            list,
+            radii.as_deref(),
+            it % STAGNATION_WINDOW == 0,
+            &mut f,
+            &mut t,
+        );
         if let Some(k) = kernels {
             k.add_reduced(state, kernel_scale, &mut scratch, &mut f, &mut t);
         }

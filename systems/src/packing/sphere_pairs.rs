@@ -36,8 +36,28 @@ pub fn sphere_radii(state: &PackingState) -> Option<Vec<f64>> {
 }
 
 /// Add the overlap forces of the sphere `pairs` (radii `radii`, see [`sphere_radii`]) to
-/// `force`; returns (largest overlap, energy) of the pairs.
+/// `force`; returns (largest overlap, energy) of the pairs, the energy only `with_energy`
+/// (else 0: FIRE reads it once per stagnation window).
+///
+/// The pairs come sorted by i, so i's force is summed in a register over its run of pairs and
+/// stored once (the same additions in the same order as `force[i] -= f` pair by pair, without
+/// a store-to-load round trip per pair).
 pub fn sphere_pair_forces(
+    state: &PackingState,
+    radii: &[f64],
+    pairs: &[PairEntry],
+    force: &mut [DVec3],
+    with_energy: bool,
+) -> (f64, f64) {
+    if with_energy {
+        pair_forces::<true>(state, radii, pairs, force)
+    } else {
+        pair_forces::<false>(state, radii, pairs, force)
+    }
+}
+
+#[inline(always)]
+fn pair_forces<const ENERGY: bool>(
     state: &PackingState,
     radii: &[f64],
     pairs: &[PairEntry],
@@ -46,8 +66,17 @@ pub fn sphere_pair_forces(
     let (x, edges) = (&state.positions[..], state.edges);
     let mut max_overlap: f64 = 0.0;
     let mut energy = 0.0;
+    let mut current = usize::MAX;
+    let mut fi = DVec3::ZERO;
     for p in pairs {
         let (i, j) = (p.i as usize, p.j as usize);
+        if i != current {
+            if current != usize::MAX {
+                force[current] = fi;
+            }
+            current = i;
+            fi = force[i];
+        }
         let r = x[j] + p.shift(edges) - x[i];
         let d = r.length();
         let overlap = radii[i] + radii[j] - d;
@@ -70,10 +99,19 @@ pub fn sphere_pair_forces(
             .normal
         };
         max_overlap = max_overlap.max(overlap);
-        energy += 0.5 * overlap * overlap;
+        if ENERGY {
+            energy += 0.5 * overlap * overlap;
+        }
         let f = overlap * normal;
-        force[i] -= f;
-        force[j] += f;
+        fi -= f;
+        if j == i {
+            fi += f; // a particle and its own image
+        } else {
+            force[j] += f;
+        }
+    }
+    if current != usize::MAX {
+        force[current] = fi;
     }
     (max_overlap, energy)
 }
@@ -111,7 +149,7 @@ mod tests {
         list.build(&mut state);
         let radii = sphere_radii(&state).unwrap();
         let mut f = vec![DVec3::ZERO; n];
-        let (max, energy) = sphere_pair_forces(&state, &radii, list.unique(), &mut f);
+        let (max, energy) = sphere_pair_forces(&state, &radii, list.unique(), &mut f, true);
         let (mut g, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
         let (max_g, energy_g, fallbacks) =
             overlap_forces_generic(&state, &mut list, &mut g, &mut t);
