@@ -267,20 +267,15 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
     let threads = rayon::current_num_threads();
     let mut rows = Vec::new();
     let (n_small, n_large) = if quick { (100, 1000) } else { (500, 10_000) };
-    // 1. spheres to the jammed state (default settings)
-    let cfg = PackingConfig::defaults_for(n_small, 1.0);
-    let r = packing_run(
-        n_small,
-        Shape::Sphere { radius: 0.5 },
-        &cfg,
-        1,
-        f64::INFINITY,
-    )?;
+    // 1. spheres to the jammed state: the shipped scene through the scene pipeline
+    let (summary, wall) = crate::studies::bench_scene::spheres_scene_run(n_small)?;
+    let attempts = summary["attempts"].as_f64().unwrap_or(f64::NAN);
     emit(
         &mut rows,
         as_json,
-        json!({"name": "packing_spheres_to_jamming", "particles": n_small, "threads": 1, "wall_time_s": r.wall_time_s, "attempts_per_s": r.attempts as f64 / r.wall_time_s, "packing_fraction": r.packing_fraction, "steps": r.steps}),
+        json!({"name": "packing_spheres_to_jamming", "particles": n_small, "threads": 1, "wall_time_s": wall, "attempts_per_s": attempts / wall, "packing_fraction": summary["packing_fraction"], "mean_contact_number": summary["mean_contact_number"], "steps": summary["compression_steps"], "path": "scene"}),
     )?;
+    let cfg = PackingConfig::defaults_for(n_small, 1.0);
     // 2. rods of aspect ratio 5 to the jammed state
     let rod = Shape::Spherocylinder {
         radius: 0.5,

@@ -35,7 +35,9 @@ use glam::{DQuat, DVec3};
 use super::external::PackingKernels;
 use super::neighbour::NeighbourList;
 use super::removal::{RemovalOutcome, turn_bound};
+use super::sphere_pairs::{sphere_pair_forces, sphere_radii};
 use super::state::{BodyKind, PackingState};
+use super::walls::WallKind;
 
 /// Iterations over which a stagnating energy ends the minimisation as failed.
 pub const STAGNATION_WINDOW: u64 = 2000;
@@ -59,10 +61,36 @@ impl Default for FireParams {
 }
 
 /// Forces and torques of the overlap energy (pairs and walls); returns (max overlap, energy,
-/// contact-solver fallbacks).
+/// contact-solver fallbacks). Sphere-only packings take the kernel of [`super::sphere_pairs`]
+/// (same forces bit for bit; sphere torques exactly zero).
 pub fn overlap_forces(
     state: &PackingState,
     list: &mut NeighbourList,
+    force: &mut [DVec3],
+    torque: &mut [DVec3],
+) -> (f64, f64, u64) {
+    let radii = sphere_radii(state);
+    overlap_forces_with(state, list, radii.as_deref(), true, force, torque)
+}
+
+/// [`overlap_forces`] by the generic contact route for every body (the reference of the
+/// sphere kernel).
+pub fn overlap_forces_generic(
+    state: &PackingState,
+    list: &mut NeighbourList,
+    force: &mut [DVec3],
+    torque: &mut [DVec3],
+) -> (f64, f64, u64) {
+    overlap_forces_with(state, list, None, true, force, torque)
+}
+
+/// [`overlap_forces`] with the sphere radii known (`Some` only when every body is a sphere);
+/// the sphere kernel sums the pairs' energy only `with_energy`.
+fn overlap_forces_with(
+    state: &PackingState,
+    list: &mut NeighbourList,
+    sphere_radii: Option<&[f64]>,
+    with_energy: bool,
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
@@ -71,23 +99,31 @@ pub fn overlap_forces(
     let mut max_overlap: f64 = 0.0;
     let mut energy = 0.0;
     let mut fallbacks = 0;
-    let pairs: Vec<(usize, usize, usize)> = list.unique_entries().collect();
-    for (i, j, k) in pairs {
-        let shift = list.entry(k).shift(state.edges);
-        let c = state.contact_warm(i, j, shift, list.warm_mut(k));
-        fallbacks += c.fallback as u64;
-        if c.overlap <= 0.0 {
-            continue;
+    if let Some(radii) = sphere_radii {
+        (max_overlap, energy) = sphere_pair_forces(state, radii, list.unique(), force, with_energy);
+    } else {
+        for idx in 0..list.unique().len() {
+            let p = list.unique()[idx];
+            let (i, j, k) = (p.i as usize, p.j as usize, p.k as usize);
+            let shift = list.entry(k).shift(state.edges);
+            let c = state.contact_warm(i, j, shift, list.warm_mut(k));
+            fallbacks += c.fallback as u64;
+            if c.overlap <= 0.0 {
+                continue;
+            }
+            max_overlap = max_overlap.max(c.overlap);
+            energy += 0.5 * c.overlap * c.overlap;
+            let f = c.overlap * c.normal;
+            force[i] -= f;
+            force[j] += f;
+            let ri = c.rc_i - 0.5 * c.overlap * c.normal;
+            let rj = c.rc_j + 0.5 * c.overlap * c.normal;
+            torque[i] += ri.cross(-f);
+            torque[j] += rj.cross(f);
         }
-        max_overlap = max_overlap.max(c.overlap);
-        energy += 0.5 * c.overlap * c.overlap;
-        let f = c.overlap * c.normal;
-        force[i] -= f;
-        force[j] += f;
-        let ri = c.rc_i - 0.5 * c.overlap * c.normal;
-        let rj = c.rc_j + 0.5 * c.overlap * c.normal;
-        torque[i] += ri.cross(-f);
-        torque[j] += rj.cross(f);
+    }
+    if state.walls == WallKind::Periodic {
+        return (max_overlap, energy, fallbacks);
     }
     let mut walls = Vec::new();
     for i in 0..state.len() {
@@ -148,6 +184,8 @@ pub fn remove_overlaps_fire_with(
         .map(|b| b.inertia.max_element())
         .collect();
     let rotates: Vec<bool> = state.bodies.iter().map(|b| b.rotates()).collect();
+    let any_rotates = rotates.iter().any(|r| *r);
+    let radii = sphere_radii(state);
     let axisymmetric: Vec<bool> = state
         .bodies
         .iter()
@@ -160,7 +198,14 @@ pub fn remove_overlaps_fire_with(
     let mut window_energy = f64::INFINITY;
     loop {
         list.ensure(state);
-        let (max_overlap, energy, fb) = overlap_forces(state, list, &mut f, &mut t);
+        let (max_overlap, energy, fb) = overlap_forces_with(
+            state,
+            list,
+            radii.as_deref(),
+            it % STAGNATION_WINDOW == 0,
+            &mut f,
+            &mut t,
+        );
         if let Some(k) = kernels {
             k.add_reduced(state, kernel_scale, &mut scratch, &mut f, &mut t);
         }
@@ -199,11 +244,20 @@ pub fn remove_overlaps_fire_with(
         }
         it += 1;
         // FIRE mixing on the global (translation + rotation) velocity vector
+        // (without rotating bodies t = w = 0, and adding their +0 terms changes no bit)
         let (mut p, mut vv, mut ff) = (0.0, 0.0, 0.0);
-        for i in 0..n {
-            p += f[i].dot(v[i]) + t[i].dot(w[i]);
-            vv += v[i].length_squared() + w[i].length_squared();
-            ff += f[i].length_squared() + t[i].length_squared();
+        if any_rotates {
+            for i in 0..n {
+                p += f[i].dot(v[i]) + t[i].dot(w[i]);
+                vv += v[i].length_squared() + w[i].length_squared();
+                ff += f[i].length_squared() + t[i].length_squared();
+            }
+        } else {
+            for i in 0..n {
+                p += f[i].dot(v[i]);
+                vv += v[i].length_squared();
+                ff += f[i].length_squared();
+            }
         }
         if p > 0.0 {
             let scale = if ff > 0.0 {
@@ -213,7 +267,9 @@ pub fn remove_overlaps_fire_with(
             };
             for i in 0..n {
                 v[i] = (1.0 - alpha) * v[i] + scale * f[i];
-                w[i] = (1.0 - alpha) * w[i] + scale * t[i];
+                if rotates[i] {
+                    w[i] = (1.0 - alpha) * w[i] + scale * t[i];
+                }
             }
             since_negative += 1;
             if since_negative > 5 {
@@ -229,9 +285,14 @@ pub fn remove_overlaps_fire_with(
         }
         for i in 0..n {
             v[i] += dt * f[i] / mass[i];
-            w[i] += dt * t[i] / rot_inertia[i];
             let dx = dt * v[i];
             state.positions[i] += dx;
+            if !rotates[i] {
+                // t = w = 0 (zeroed above): no turn
+                list.note_move(i, dx, 0.0);
+                continue;
+            }
+            w[i] += dt * t[i] / rot_inertia[i];
             let angle = w[i].length() * dt;
             let mut turn = 0.0;
             if angle > 0.0 {

@@ -3,7 +3,8 @@
 //! Kernels on dense arrays in reduced units ([`state`], bodies in [`body`]): contacts
 //! ([`contact`]), user force kernels in reduced units ([`external`]), the Verlet
 //! list over all periodic images ([`neighbour`]), the move rules ([`moves`]), overlap-removal
-//! sweeps ([`removal`]), the compression driver ([`compress`]), random insertion ([`insert`]).
+//! sweeps ([`removal`]), FIRE ([`fire`]) with its sphere-pair force kernel ([`sphere_pairs`]),
+//! the compression driver ([`compress`]), random insertion ([`insert`]).
 //! The ECS glue is in [`systems`].
 
 pub mod body;
@@ -15,6 +16,7 @@ pub mod insert;
 pub mod moves;
 pub mod neighbour;
 pub mod removal;
+pub mod sphere_pairs;
 pub mod state;
 pub mod systems;
 pub mod walls;

@@ -44,6 +44,29 @@ fn image_of(shift: DVec3, edges: DVec3) -> [i16; 3] {
     [r.x as i16, r.y as i16, r.z as i16]
 }
 
+/// One unordered pair of the list (i < j, or i == j for a self-image pair with a positive
+/// image), stored flat at build time so that force loops walk a slice instead of filtering
+/// the symmetric CSR on every evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairEntry {
+    /// First particle.
+    pub i: u32,
+    /// Second particle.
+    pub j: u32,
+    /// Index of i's directed entry (for [`NeighbourList::warm_mut`]).
+    pub k: u32,
+    /// Image of j as floats: the shift is `image * edges` with the edges of the moment.
+    pub image: DVec3,
+}
+
+impl PairEntry {
+    /// The image shift for a box of edges `edges` (bit for bit [`Neighbour::shift`]).
+    #[inline]
+    pub fn shift(&self, edges: DVec3) -> DVec3 {
+        self.image * edges
+    }
+}
+
 /// A cell grid over the box `[0, edges]` with cells no smaller than a cut-off, periodic along
 /// the flagged axes (where at least three cells fit) and clamped along walled axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,6 +187,8 @@ pub struct NeighbourList {
     /// Superquadric contact solutions per directed entry, the next call's Newton start
     /// (carried over rebuilds for pairs that stay listed).
     warm: Vec<Option<WarmStart>>,
+    /// Each unordered pair once, in [`Self::unique_entries`] order.
+    pairs: Vec<PairEntry>,
 }
 
 impl NeighbourList {
@@ -343,6 +368,20 @@ impl NeighbourList {
                 }
             }
         }
+        self.pairs.clear();
+        for i in 0..n {
+            for k in self.start[i] as usize..self.start[i + 1] as usize {
+                let nb = self.entries[k];
+                if nb.j as usize > i || (nb.j as usize == i && nb.image > [0, 0, 0]) {
+                    self.pairs.push(PairEntry {
+                        i: i as u32,
+                        j: nb.j,
+                        k: k as u32,
+                        image: nb.shift(DVec3::ONE),
+                    });
+                }
+            }
+        }
         self.moved = vec![0.0; n];
         self.max_moved = 0.0;
         self.compressed = 0.0;
@@ -350,16 +389,18 @@ impl NeighbourList {
         self.builds += 1;
     }
 
-    /// Each unordered pair once with its directed entry index (for [`Self::warm_mut`]).
+    /// Each unordered pair once with its directed entry index (for [`Self::warm_mut`]): by
+    /// i, then in [`Self::of`] order.
     pub fn unique_entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        (0..self.start.len().saturating_sub(1)).flat_map(move |i| {
-            let first = self.start[i] as usize;
-            self.of(i).iter().enumerate().filter_map(move |(k, nb)| {
-                let j = nb.j as usize;
-                let keep = j > i || (j == i && nb.image > [0, 0, 0]);
-                keep.then_some((i, j, first + k))
-            })
-        })
+        self.pairs
+            .iter()
+            .map(|p| (p.i as usize, p.j as usize, p.k as usize))
+    }
+
+    /// Each unordered pair once, in [`Self::unique_entries`] order.
+    #[inline]
+    pub fn unique(&self) -> &[PairEntry] {
+        &self.pairs
     }
 
     /// Index of i's first entry (entries of i are `entry_start(i)..` in [`Self::of`] order).
@@ -383,13 +424,9 @@ impl NeighbourList {
     /// Each unordered pair once: (i, j, shift) with i < j, or i == j for self-image pairs;
     /// shifts for a box of edges `edges`.
     pub fn unique_pairs(&self, edges: DVec3) -> impl Iterator<Item = (usize, usize, DVec3)> + '_ {
-        (0..self.start.len().saturating_sub(1)).flat_map(move |i| {
-            self.of(i).iter().filter_map(move |nb| {
-                let j = nb.j as usize;
-                let keep = j > i || (j == i && nb.image > [0, 0, 0]);
-                keep.then_some((i, j, nb.shift(edges)))
-            })
-        })
+        self.pairs
+            .iter()
+            .map(move |p| (p.i as usize, p.j as usize, p.shift(edges)))
     }
 }
 

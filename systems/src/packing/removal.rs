@@ -76,8 +76,9 @@ pub fn overlap_scan(
     flags.clear();
     flags.resize(state.len(), false);
     let mut scan = OverlapScan::default();
-    let pairs: Vec<(usize, usize, usize)> = list.unique_entries().collect();
-    for (i, j, k) in pairs {
+    for idx in 0..list.unique().len() {
+        let p = list.unique()[idx];
+        let (i, j, k) = (p.i as usize, p.j as usize, p.k as usize);
         let shift = list.entry(k).shift(state.edges);
         let c = state.contact_warm(i, j, shift, list.warm_mut(k));
         scan.contacts += 1;
