@@ -218,6 +218,8 @@ pub fn update_velocities(
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
     let added = cfg.terms.added_mass;
     let spin = cfg.spheroids.spin;
+    // non-finite velocities: counted, the first one named (one message, not one per particle)
+    let mut failed: (usize, Option<u64>) = (0, None);
     for (id, f, t, b, drag, rot, mut v, mut w, hist, (o, spheroid)) in &mut q {
         let mass = effective_mass(b.mass, b.volume, rho, added);
         let mut stiffness = 0.0;
@@ -244,14 +246,18 @@ pub fn update_velocities(
             velocity_step(w.0, t.0, b.inertia.x, k_rot, dt)
         };
         if !(v_new.is_finite() && w_new.is_finite()) {
-            health.report(format!(
-                "non-finite velocity of particle {} (dt too large for the explicit scheme?)",
-                id.0
-            ));
+            failed.0 += 1;
+            failed.1.get_or_insert(id.0 as u64);
             continue;
         }
         v.0 = v_new;
         w.0 = w_new;
+    }
+    if let (n, Some(first)) = failed {
+        health.report(format!(
+            "non-finite velocity of {n} particle(s), the first particle {first} (time step too \
+             large for the explicit scheme, or an unstable coupling to the solved liquid?)"
+        ));
     }
 }
 

@@ -59,7 +59,9 @@ pub struct ChannelSpec {
     #[serde(default)]
     pub coupling: CouplingLevel,
     /// Subtract the particle's own filtered Stokeslet from the sampled velocity
-    /// ([`super::self_induced`]). Default false (the thesis applies no correction).
+    /// ([`super::self_induced`]). Default false (the thesis applies no correction). A Stokes
+    /// response: for particle Reynolds numbers of order one and beyond it over-corrects and
+    /// can make the run diverge (docs/references.md D-002-19).
     #[serde(default)]
     pub self_induced_correction: bool,
     /// Dealias the nonlinear term (3/2 rule). Default true.
