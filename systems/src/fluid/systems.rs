@@ -247,7 +247,7 @@ pub fn update_velocities(
         };
         if !(v_new.is_finite() && w_new.is_finite()) {
             failed.0 += 1;
-            failed.1.get_or_insert(id.0 as u64);
+            failed.1.get_or_insert(id.0);
             continue;
         }
         v.0 = v_new;
