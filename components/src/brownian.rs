@@ -235,6 +235,10 @@ pub struct BrownianStats {
     pub mobility_reason: String,
     /// Krylov iterations in all.
     pub krylov_iterations: u64,
+    /// Neighbour-list rebuilds of the pair forces (Verlet lists with a skin). A cost counter,
+    /// not state: not recorded in checkpoints (a resumed run counts its own rebuilds).
+    #[serde(skip)]
+    pub neighbour_list_builds: u64,
 }
 
 /// Capture curve of one run: `(step, captured count)` samples (a resource).

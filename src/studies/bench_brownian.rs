@@ -16,6 +16,7 @@
 
 mod cost;
 mod hi;
+mod lammps_case;
 mod pipeline;
 
 use std::path::Path;
@@ -27,6 +28,7 @@ use crate::studies::bench::{BenchError, emit, log_slope};
 
 pub use cost::{CostChartSizes, CostPoint, cost_points};
 pub use hi::{MobilityStepTime, random_configuration, time_mobility_step};
+pub use lammps_case::lammps_mirror_scene;
 pub use pipeline::{PipelineRate, free_draining_scene, mean_neighbours, pipeline_rate};
 
 /// Particle radius of every benchmark \[m\].
@@ -92,6 +94,8 @@ pub struct BrownianBenchSizes {
     pub hi_sizes: Vec<usize>,
     /// Mobility methods of the HI cost benchmark.
     pub hi_methods: Vec<MobilityMethod>,
+    /// Lattice cells per side of the LAMMPS-mirror case (`ncell³` particles; 0: not run).
+    pub mirror_ncell: usize,
 }
 
 impl BrownianBenchSizes {
@@ -108,6 +112,7 @@ impl BrownianBenchSizes {
                 MobilityMethod::Tea,
                 MobilityMethod::Krylov,
             ],
+            mirror_ncell: 22,
         }
     }
 
@@ -208,6 +213,40 @@ pub fn bench_brownian_with(
                 }),
             )?;
             last_positions = x;
+        }
+    }
+    // (a') the configuration of the LAMMPS peer (anchor-bench `lammps_bd.sh`)
+    if sizes.mirror_ncell > 0 {
+        let text = lammps_mirror_scene(sizes.mirror_ncell, 1)?;
+        let scene = crate::scene::parse_scene(&text, &Default::default())
+            .map_err(|e| BenchError::Runtime(format!("mirror scene: {e}")))?;
+        let mirror_n = sizes.mirror_ncell.pow(3);
+        for &threads in &sizes.threads {
+            let (r, _) =
+                pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
+            emit(
+                &mut rows,
+                as_json,
+                json!({
+                    "name": "brownian_lammps_mirror",
+                    "bench": "brownian",
+                    "case": "lammps_mirror",
+                    "threads": threads,
+                    "n": mirror_n,
+                    "reduced_density": lammps_case::REDUCED_DENSITY,
+                    "dipole_cutoff_sigma": lammps_case::CUTOFF_SIGMA,
+                    "core": "Mie(12,6) = WCA, epsilon = kT",
+                    "dt_s": lammps_case::dt_and_moment().0,
+                    "steps": r.steps,
+                    "wall_time_s": r.seconds,
+                    "particle_steps_per_s": r.particle_steps_per_s,
+                    "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
+                    "peer": {"impl": "lammps", "case": "bd_dipoles", "threads": 1,
+                             "metric": "particle_steps_per_s"},
+                    "differs": "moments held along the field (no rotation); unbounded domain",
+                    "load_average_1min": load_average(),
+                }),
+            )?;
         }
     }
     let rc = DIPOLE_CUTOFF * RADIUS;

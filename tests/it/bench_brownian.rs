@@ -28,6 +28,7 @@ fn bench_rows_are_well_formed_with_positive_rates() {
             MobilityMethod::Tea,
             MobilityMethod::Krylov,
         ],
+        mirror_ncell: 4,
     };
     let rows = bench_brownian_with(&sizes, true).unwrap();
     // every row survives a JSON round trip
@@ -51,6 +52,13 @@ fn bench_rows_are_well_formed_with_positive_rates() {
         } else {
             assert!(sub >= 2.0);
         }
+    }
+    let mirror = case("lammps_mirror");
+    assert_eq!(mirror.len(), 2, "1 and 2 threads");
+    for r in &mirror {
+        positive(r, "particle_steps_per_s");
+        assert_eq!(r["n"], 64);
+        assert_eq!(r["peer"]["impl"], "lammps");
     }
     let nb = case("dipole_neighbours");
     assert_eq!(nb.len(), 1);

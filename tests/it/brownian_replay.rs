@@ -104,7 +104,14 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
         "steps",
         "stepper",
     ] {
-        assert_eq!(resumed[key], summary[key], "{key}");
+        let (mut a, mut b) = (resumed[key].clone(), summary[key].clone());
+        // a cost counter, not state: the resumed run builds its lists afresh
+        for v in [&mut a, &mut b] {
+            if let Some(o) = v.as_object_mut() {
+                o.remove("neighbour_list_builds");
+            }
+        }
+        assert_eq!(a, b, "{key}");
     }
     let again = read_recording(&resumed_path).unwrap();
     let (a, b) = (rec.frames.last().unwrap(), again.frames.last().unwrap());

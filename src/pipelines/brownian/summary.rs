@@ -195,6 +195,7 @@ pub fn summary_of(
         stats.force_evaluations += s.force_evaluations;
         stats.hard_core_sweeps += s.hard_core_sweeps;
         stats.krylov_iterations += s.krylov_iterations;
+        stats.neighbour_list_builds += s.neighbour_list_builds;
         stats.mobility.clone_from(&s.mobility);
         stats.mobility_reason.clone_from(&s.mobility_reason);
     }
@@ -237,6 +238,7 @@ pub fn summary_of(
             "depth_limit_hits": stats.depth_limit_hits,
             "hard_core_sweeps": stats.hard_core_sweeps,
             "krylov_iterations": stats.krylov_iterations,
+            "neighbour_list_builds": stats.neighbour_list_builds,
         },
         "captured_fraction": est(fraction(results, |r| captured_by(r, None, steps + 1))),
         "volume_weighted_captured_fraction": weighted.filter(|w| w.0 > 0.0).map(|w| w.1 / w.0),

@@ -11,7 +11,7 @@ use crate::forces::{ExternalForces, ParticleState};
 
 use super::contact::{remove_overlaps, swept_capture};
 use super::hydro::Mobility;
-use super::model::{ForceModel, ForceParts, ParticleView};
+use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
 use super::stepper::Dynamics;
 
 /// Hydrodynamic interactions among the free particles: the prepared mobility and the particle
@@ -57,6 +57,10 @@ pub struct PipelineDynamics<'a> {
     pub kt: f64,
     /// Hydrodynamic interactions (None: free draining).
     pub hydro: Option<&'a HydroState>,
+    /// Neighbour lists of the pair forces (cached across evaluations).
+    pub lists: &'a mut PairLists,
+    /// Neighbour-list rebuilds in this step.
+    pub list_builds: u64,
     /// Hard cores.
     pub hard_core: bool,
     /// Step being taken (for capture events).
@@ -124,7 +128,9 @@ impl Dynamics for PipelineDynamics<'_> {
             exerts: &exerts,
         };
         let mut parts = std::mem::take(&mut self.parts);
-        self.model.evaluate(x, &view, &mut parts);
+        let before = self.lists.builds();
+        self.model.evaluate(x, &view, self.lists, &mut parts);
+        self.list_builds += self.lists.builds() - before;
         let mut f: Vec<DVec3> = (0..x.len())
             .map(|i| parts.total(i) + self.extra[i])
             .collect();

@@ -11,3 +11,4 @@ pub mod model;
 pub mod pair;
 pub mod stepper;
 pub mod systems;
+pub mod verlet;

@@ -8,8 +8,9 @@
 //! * Field force `F = |m| ∇|B|` ([`crate::field::dipole_force`]), computed with the moments
 //!   from one field evaluation per particle; with no fibres the applied
 //!   field is uniform and exerts no force.
-//! * Pair forces are summed per particle over a [`CellList`] in a fixed order, in parallel over
-//!   particles: bitwise identical for any thread count.
+//! * Pair forces are summed per particle over cached Verlet lists ([`VerletList`], one per
+//!   range, rebuilt only when a particle has moved half the skin) in a fixed order, in
+//!   parallel over particles: bitwise identical for any thread count.
 //!
 //! Which particles feel forces (`mobile`) and which exert pair forces (`exerts`) are separate
 //! masks, so captured particles can keep or stop interacting (a scene option).
@@ -18,8 +19,8 @@ use glam::DVec3;
 use magsep_components::brownian::MomentModel;
 use rayon::prelude::*;
 
-use super::cells::CellList;
 use super::pair::{Mie, dipole_force};
+use super::verlet::VerletList;
 use crate::field::{CylinderSource, FieldGradient, total_field, total_field_gradient};
 
 /// Per-particle data the force model reads (all slices of length N, in `ParticleId` order).
@@ -66,13 +67,32 @@ impl ForceParts {
     }
 }
 
-/// The cell lists of one configuration.
+/// The neighbour lists of the pair forces, cached across evaluations.
 #[derive(Debug, Clone, Default)]
-pub struct PairCells {
-    /// Cells of the dipole cut-off (None: no dipole forces).
-    pub dipole: Option<CellList>,
-    /// Cells of the Mie range (None: no soft core).
-    pub contact: Option<CellList>,
+pub struct PairLists {
+    /// Pairs within the dipole cut-off (used when the model has one).
+    pub dipole: VerletList,
+    /// Pairs within the Mie range (used when the model has a soft core).
+    pub contact: VerletList,
+}
+
+impl PairLists {
+    /// Rebuilds of both lists so far.
+    pub fn builds(&self) -> u64 {
+        self.dipole.builds() + self.contact.builds()
+    }
+
+    /// Rebuild both lists at every evaluation (the uncached reference of the tests).
+    pub fn set_rebuild_always(&mut self, on: bool) {
+        self.dipole.rebuild_always = on;
+        self.contact.rebuild_always = on;
+    }
+}
+
+/// Skin of a list of pair range `range` for largest radius `amax` \[m\]: 15 % of the range,
+/// at least 0.6 radii (0.3 diameters, LAMMPS's default skin in reduced units).
+pub fn list_skin(range: f64, amax: f64) -> f64 {
+    (0.15 * range).max(0.6 * amax)
 }
 
 /// Fibres, applied field and interaction parameters.
@@ -91,6 +111,9 @@ pub struct ForceModel {
     /// Dipole cut-off in units of the pair's mean radius (None: no dipole forces).
     pub dipole_cutoff: Option<f64>,
 }
+
+/// Particles per chunk of the pair-force pass.
+const PAIR_CHUNK: usize = 256;
 
 /// Parallel map over particles in chunks (sequential below 512 particles).
 fn par_fill<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
@@ -161,18 +184,24 @@ impl ForceModel {
         }
     }
 
-    /// Cell lists of the particles that exert pair forces: one with the dipole cut-off of the
-    /// largest pair, one with the Mie range (so contacts do not scan the dipole neighbourhood).
-    pub fn cells(&self, x: &[DVec3], view: &ParticleView) -> PairCells {
+    /// Make the neighbour lists of the particles that exert pair forces serve `x`: one with
+    /// the dipole cut-off of the largest pair, one with the Mie range (so contacts do not scan
+    /// the dipole neighbourhood). Returns the number of lists rebuilt.
+    pub fn update_lists(&self, x: &[DVec3], view: &ParticleView, lists: &mut PairLists) -> u64 {
         let amax = view.radii.iter().copied().fold(0.0, f64::max);
-        let build = |range: f64, reach: i64| {
-            (range > 0.0 && range.is_finite())
-                .then(|| CellList::build_with_reach(x, range, reach, |j| view.exerts[j]))
+        let mut rebuilt = 0;
+        let mut ensure = |list: &mut VerletList, range: f64| {
+            if range > 0.0 && range.is_finite() {
+                rebuilt += list.ensure(x, view.exerts, range, list_skin(range, amax)) as u64;
+            }
         };
-        PairCells {
-            dipole: self.dipole_cutoff.and_then(|c| build(c * amax, 2)),
-            contact: self.mie.and_then(|m| build(2.0 * amax * m.min_ratio, 1)),
+        if let Some(c) = self.dipole_cutoff {
+            ensure(&mut lists.dipole, c * amax);
         }
+        if let Some(m) = self.mie {
+            ensure(&mut lists.contact, 2.0 * amax * m.min_ratio);
+        }
+        rebuilt
     }
 
     /// Dipole-dipole forces on the mobile particles from the exerting ones \[N\].
@@ -181,13 +210,86 @@ impl ForceModel {
         x: &[DVec3],
         moments: &[DVec3],
         view: &ParticleView,
-        cells: &PairCells,
+        lists: &PairLists,
         out: &mut [DVec3],
     ) {
-        let (Some(cut), Some(cells)) = (self.dipole_cutoff, cells.dipole.as_ref()) else {
+        let Some(cut) = self.dipole_cutoff else {
             out.fill(DVec3::ZERO);
             return;
         };
+        let list = &lists.dipole;
+        let pair = |i: usize, j: usize, d: DVec3| {
+            let rc = cut * 0.5 * (view.radii[i] + view.radii[j]);
+            if d.length_squared() < rc * rc {
+                dipole_force(d, moments[i], moments[j])
+            } else {
+                DVec3::ZERO
+            }
+        };
+        // each pair once (the force on its lower index), into its slot; chunks of particles
+        // own consecutive slot ranges
+        let n = x.len();
+        let mut pf = vec![DVec3::ZERO; list.pair_count()];
+        let mut parts: Vec<(usize, &mut [DVec3])> = Vec::with_capacity(n.div_ceil(PAIR_CHUNK));
+        let mut rest = pf.as_mut_slice();
+        for c in 0..n.div_ceil(PAIR_CHUNK) {
+            let (a, b) = (c * PAIR_CHUNK, ((c + 1) * PAIR_CHUNK).min(n));
+            let len = list.owned_range(a, b).len().min(rest.len());
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            parts.push((a, head));
+            rest = tail;
+        }
+        parts.into_par_iter().for_each(|(a, out)| {
+            let mut k = 0;
+            for i in a..(a + PAIR_CHUNK).min(n) {
+                let (js, _) = list.owned(i);
+                let (xi, ai, mi) = (x[i], view.radii[i], moments[i]);
+                for &j in js {
+                    let j = j as usize;
+                    let d = xi - x[j];
+                    let rc = cut * 0.5 * (ai + view.radii[j]);
+                    if d.length_squared() < rc * rc {
+                        out[k] = dipole_force(d, mi, moments[j]);
+                    }
+                    k += 1;
+                }
+            }
+        });
+        debug_assert_eq!(pf.len(), list.pair_count());
+        // gathered by both particles, each in its own list order
+        par_fill(out, |i, f| {
+            *f = DVec3::ZERO;
+            if !view.mobile[i] || moments[i] == DVec3::ZERO {
+                return;
+            }
+            let mut sum = DVec3::ZERO;
+            for (j, s) in list.entries(i) {
+                sum += match pf.get(s as usize) {
+                    Some(&p) if j > i => p,
+                    Some(&p) => -p,
+                    None => pair(i, j, x[i] - x[j]),
+                };
+            }
+            *f = sum;
+        });
+    }
+
+    /// [`ForceModel::dipole_forces`] computed per particle over every neighbour, each pair
+    /// twice: the simple reference the pair kernel is tested against.
+    pub fn dipole_forces_direct(
+        &self,
+        x: &[DVec3],
+        moments: &[DVec3],
+        view: &ParticleView,
+        lists: &PairLists,
+        out: &mut [DVec3],
+    ) {
+        let Some(cut) = self.dipole_cutoff else {
+            out.fill(DVec3::ZERO);
+            return;
+        };
+        let amax = view.radii.iter().copied().fold(0.0, f64::max);
+        let (list, range) = (&lists.dipole, cut * amax);
         par_fill(out, |i, f| {
             *f = DVec3::ZERO;
             if !view.mobile[i] || moments[i] == DVec3::ZERO {
@@ -195,7 +297,7 @@ impl ForceModel {
             }
             let (ai, mi) = (view.radii[i], moments[i]);
             let mut sum = DVec3::ZERO;
-            cells.for_each_neighbour(x, i, cells.edge(), |j, d| {
+            list.for_each_neighbour(x, i, range, |j, d| {
                 let rc = cut * 0.5 * (ai + view.radii[j]);
                 if d.length_squared() < rc * rc {
                     sum += dipole_force(d, mi, moments[j]);
@@ -210,13 +312,15 @@ impl ForceModel {
         &self,
         x: &[DVec3],
         view: &ParticleView,
-        cells: &PairCells,
+        lists: &PairLists,
         out: &mut [DVec3],
     ) {
-        let (Some(mie), Some(cells)) = (self.mie, cells.contact.as_ref()) else {
+        let Some(mie) = self.mie else {
             out.fill(DVec3::ZERO);
             return;
         };
+        let amax = view.radii.iter().copied().fold(0.0, f64::max);
+        let (list, range) = (&lists.contact, 2.0 * amax * mie.min_ratio);
         par_fill(out, |i, f| {
             *f = DVec3::ZERO;
             if !view.mobile[i] {
@@ -224,24 +328,96 @@ impl ForceModel {
             }
             let ai = view.radii[i];
             let mut sum = DVec3::ZERO;
-            cells.for_each_neighbour(x, i, cells.edge(), |j, d| {
+            list.for_each_neighbour(x, i, range, |j, d| {
                 sum += mie.force(d, ai + view.radii[j]);
             });
             *f = sum;
         });
     }
 
-    /// All parts at configuration `x` (the sub-step evaluation of the integrator).
-    pub fn evaluate(&self, x: &[DVec3], view: &ParticleView, parts: &mut ForceParts) {
+    /// All parts at configuration `x` (the sub-step evaluation of the integrator), with the
+    /// lists brought up to date.
+    pub fn evaluate(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        lists: &mut PairLists,
+        parts: &mut ForceParts,
+    ) {
         let n = x.len();
         if parts.field.len() != n {
             *parts = ForceParts::zeros(n);
         }
         self.moments_and_field(x, view, &mut parts.moments, &mut parts.field);
-        let cells = self.cells(x, view);
+        self.update_lists(x, view, lists);
         let moments = std::mem::take(&mut parts.moments);
-        self.dipole_forces(x, &moments, view, &cells, &mut parts.dipole);
+        self.dipole_forces(x, &moments, view, lists, &mut parts.dipole);
         parts.moments = moments;
-        self.contact_forces(x, view, &cells, &mut parts.contact);
+        self.contact_forces(x, view, lists, &mut parts.contact);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    #[test]
+    fn the_pair_kernel_equals_the_direct_sums() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let n = 900;
+        let x: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 4e-6)
+            .collect();
+        let radii: Vec<f64> = (0..n).map(|i| [75e-9, 100e-9, 50e-9][i % 3]).collect();
+        let moments: Vec<DVec3> = (0..n)
+            .map(|i| {
+                if i % 11 == 5 {
+                    DVec3::ZERO // non-magnetic
+                } else {
+                    DVec3::new(rng.random(), rng.random(), rng.random()) * 1e-16
+                }
+            })
+            .collect();
+        let laws = vec![MomentModel::default(); n];
+        let model = ForceModel {
+            sources: Vec::new(),
+            b_ext: DVec3::X,
+            tolerance: 1e-6,
+            kt: 4e-21,
+            mie: None,
+            dipole_cutoff: Some(12.0),
+        };
+        // captured particles that keep interacting, and ones that do not
+        let mobile: Vec<bool> = (0..n).map(|i| i % 7 != 2).collect();
+        for interact in [true, false] {
+            let exerts: Vec<bool> = mobile.iter().map(|&m| m || interact).collect();
+            let view = ParticleView {
+                radii: &radii,
+                moments: &laws,
+                mobile: &mobile,
+                exerts: &exerts,
+            };
+            let mut lists = PairLists::default();
+            model.update_lists(&x, &view, &mut lists);
+            assert!(lists.dipole.pair_count() > 10 * n, "dense enough to test");
+            let (mut fast, mut direct) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+            model.dipole_forces(&x, &moments, &view, &lists, &mut fast);
+            model.dipole_forces_direct(&x, &moments, &view, &lists, &mut direct);
+            let scale = direct.iter().map(|f| f.length()).fold(0.0, f64::max);
+            assert!(scale > 0.0);
+            for i in 0..n {
+                assert!(
+                    (fast[i] - direct[i]).length() <= 1e-13 * scale,
+                    "{i}: {} {}",
+                    fast[i],
+                    direct[i]
+                );
+                if !mobile[i] {
+                    assert_eq!(fast[i], DVec3::ZERO);
+                }
+            }
+        }
     }
 }

@@ -20,7 +20,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::dynamics::{HydroState, PipelineDynamics};
 use super::hydro::{Mobility, MobilityMethod, auto_method};
-use super::model::{ForceModel, PairCells, ParticleView};
+use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
 use super::stepper::advance;
 use crate::field::CylinderSource;
@@ -53,8 +53,8 @@ pub struct BrownianWorkspace {
     pub moments: Vec<DVec3>,
     /// Field forces at the step start \[N\].
     pub field: Vec<DVec3>,
-    /// Cell lists at the step start.
-    pub cells: PairCells,
+    /// Neighbour lists of the pair forces (cached across steps).
+    pub lists: PairLists,
     /// Mobility of this step (None: free draining).
     pub hydro: Option<HydroState>,
     /// Resolved mobility method.
@@ -189,7 +189,7 @@ pub fn init_brownian_workspace(world: &mut World) {
         positions,
         radii,
         model: force_model(&config, &fibres, &field),
-        cells: PairCells::default(),
+        lists: PairLists::default(),
         hydro: None,
         method,
     });
@@ -204,9 +204,13 @@ pub fn init_brownian_workspace(world: &mut World) {
     }
 }
 
-/// Moments, field forces (one field evaluation per particle) and the cell lists at the step
-/// start.
-pub fn prepare_brownian_step(mut ws: ResMut<BrownianWorkspace>, config: Res<BrownianConfig>) {
+/// Moments, field forces (one field evaluation per particle) and the neighbour lists at the
+/// step start.
+pub fn prepare_brownian_step(
+    mut ws: ResMut<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    mut stats: ResMut<BrownianStats>,
+) {
     let ws = &mut *ws;
     let mobile = ws.mobile();
     let exerts = ws.exerts(&config);
@@ -226,7 +230,7 @@ pub fn prepare_brownian_step(mut ws: ResMut<BrownianWorkspace>, config: Res<Brow
     ws.model
         .moments_and_field(&ws.positions, &view, &mut m, &mut f);
     (ws.moments, ws.field) = (m, f);
-    ws.cells = ws.model.cells(&ws.positions, &view);
+    stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
 }
 
 fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
@@ -278,7 +282,7 @@ pub fn compute_dipole_forces(
 ) {
     let f = pair_forces(&ws, &config, |view, out| {
         ws.model
-            .dipole_forces(&ws.positions, &ws.moments, view, &ws.cells, out)
+            .dipole_forces(&ws.positions, &ws.moments, view, &ws.lists, out)
     });
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
@@ -290,7 +294,7 @@ pub fn compute_contact_forces(
     mut forces: Query<&mut ContactForce>,
 ) {
     let f = pair_forces(&ws, &config, |view, out| {
-        ws.model.contact_forces(&ws.positions, view, &ws.cells, out)
+        ws.model.contact_forces(&ws.positions, view, &ws.lists, out)
     });
     write_dense(&ws, &f, &mut forces, |c, v| c.0 = v);
 }
@@ -375,6 +379,8 @@ pub fn integrate_brownian(
         viscosity: config.viscosity,
         kt: config.kt(),
         hydro: ws.hydro.as_ref(),
+        lists: &mut ws.lists,
+        list_builds: 0,
         hard_core: config.contact == ContactModel::HardCore,
         step: clock.step,
         captures: Vec::new(),
@@ -396,6 +402,7 @@ pub fn integrate_brownian(
     );
     let captures = std::mem::take(&mut dynamics.captures);
     stats.hard_core_sweeps += dynamics.sweeps;
+    stats.neighbour_list_builds += dynamics.list_builds;
     if let Some(f) = dynamics.failure.take() {
         health.report(format!("step {}: {f}", clock.step));
     }

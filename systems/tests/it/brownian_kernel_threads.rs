@@ -8,7 +8,7 @@ use glam::DVec3;
 use magsep_components::brownian::{BrownianStats, MomentModel, StepControl};
 use magsep_components::shape::Shape;
 use magsep_systems::brownian::dynamics::PipelineDynamics;
-use magsep_systems::brownian::model::ForceModel;
+use magsep_systems::brownian::model::{ForceModel, PairLists};
 use magsep_systems::brownian::stepper::advance;
 use magsep_systems::forces::{ExternalForce, ExternalForces, ParticleState};
 use magsep_systems::rng::particle_stream;
@@ -51,6 +51,7 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
         let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(5, i)).collect();
         let mut stats = BrownianStats::default();
         let dt = 1e-4;
+        let mut lists = PairLists::default();
         for step in 0..3 {
             let mut d = PipelineDynamics {
                 model: &model,
@@ -68,6 +69,8 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
                 viscosity: 1e-3,
                 kt,
                 hydro: None,
+                lists: &mut lists,
+                list_builds: 0,
                 hard_core: false,
                 step,
                 captures: Vec::new(),

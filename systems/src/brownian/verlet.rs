@@ -1,0 +1,350 @@
+//! Verlet neighbour lists with a skin for the Brownian pair sums.
+//!
+//! A list built at reference positions `x⁰` holds, for every particle `i`, the exerting
+//! particles `j` with `|x⁰_i − x⁰_j| < range + skin`. While no particle has moved more than
+//! `skin / 2` from its reference position, every pair closer than `range` is in the list (the
+//! distance can shrink by at most `skin`), so the list serves any such configuration and the
+//! pair sums need not rebin the particles: a rebuild happens when some particle crossed
+//! `skin / 2`, when the set of exerting particles changed, or when a larger range is asked for.
+//!
+//! Each particle's neighbours are stored in ascending index order, and the build is split into
+//! fixed chunks of particles, so a per-particle force sum is bitwise the same whatever the
+//! thread count.
+//!
+//! **Pairs.** Every pair of exerting particles `i < j` in the list has a slot (numbered by `i`,
+//! then `j`): [`VerletList::owned`] gives the pairs a particle owns, [`VerletList::slot`] the
+//! slot of each list entry, so a pair force can be computed once per pair into its slot and
+//! gathered by both particles (Newton's third law) in each particle's fixed list order:
+//! half the pair arithmetic and still thread-count independent sums.
+//!
+//! [`VerletList::rebuild_always`] turns the cache off (a fresh list at every evaluation): the
+//! reference the tests compare the cached path with.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::cells::CellList;
+
+/// Particles per build chunk (fixed: the list does not depend on the thread count).
+const CHUNK: usize = 256;
+
+/// Slot of an entry whose particle does not exert (no shared pair).
+pub const NO_SLOT: u32 = u32::MAX;
+
+/// A cached neighbour list (see the module header).
+#[derive(Debug, Clone, Default)]
+pub struct VerletList {
+    /// Pair range served without the skin \[m\].
+    range: f64,
+    /// Skin \[m\].
+    skin: f64,
+    /// Positions at the build \[m\].
+    reference: Vec<DVec3>,
+    /// Exerting mask at the build.
+    exerts: Vec<bool>,
+    /// `starts[i]..starts[i + 1]` indexes `neighbours` for particle i.
+    starts: Vec<u32>,
+    /// Neighbour indices (ascending for each particle).
+    neighbours: Vec<u32>,
+    /// Pair slot of each entry (`NO_SLOT` where the particle itself does not exert).
+    slots: Vec<u32>,
+    /// Offset of the first entry `j > i` within particle i's entries.
+    upper: Vec<u32>,
+    /// First slot owned by particle i (`pair_base[n]` = number of pairs).
+    pair_base: Vec<u32>,
+    /// Rebuilds so far.
+    builds: u64,
+    /// Rebuild at every [`VerletList::ensure`] (the uncached reference).
+    pub rebuild_always: bool,
+}
+
+impl VerletList {
+    /// Number of builds so far.
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// Pairs stored (each pair twice, once per particle).
+    pub fn stored_pairs(&self) -> usize {
+        self.neighbours.len()
+    }
+
+    /// Whether the list serves configuration `x` with exerting mask `exerts` for pairs closer
+    /// than `range` \[m\].
+    pub fn serves(&self, x: &[DVec3], exerts: &[bool], range: f64) -> bool {
+        if self.rebuild_always
+            || self.builds == 0
+            || range > self.range
+            || x.len() != self.reference.len()
+            || exerts != self.exerts.as_slice()
+        {
+            return false;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        // NaN displacements fail the test, so a broken configuration is rebinned (and its
+        // non-finite particles dropped by the cell list)
+        x.iter()
+            .zip(&self.reference)
+            .all(|(p, q)| (*p - *q).length_squared() <= limit)
+    }
+
+    /// Make the list serve `x` for pairs closer than `range` \[m\], rebuilding with `skin` \[m\]
+    /// if needed. Returns whether it was rebuilt.
+    pub fn ensure(&mut self, x: &[DVec3], exerts: &[bool], range: f64, skin: f64) -> bool {
+        if self.serves(x, exerts, range) {
+            return false;
+        }
+        self.build(x, exerts, range, skin.max(0.0));
+        true
+    }
+
+    fn build(&mut self, x: &[DVec3], exerts: &[bool], range: f64, skin: f64) {
+        let reach_range = range + skin;
+        let cells = CellList::build_with_reach(x, reach_range, 2, |j| exerts[j]);
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (a, b) = (c * CHUNK, ((c + 1) * CHUNK).min(x.len()));
+                let mut counts = Vec::with_capacity(b - a);
+                let mut js = Vec::new();
+                for i in a..b {
+                    let before = js.len();
+                    if x[i].is_finite() {
+                        cells.for_each_neighbour(x, i, reach_range, |j, _| js.push(j as u32));
+                    }
+                    js[before..].sort_unstable();
+                    counts.push((js.len() - before) as u32);
+                }
+                (counts, js)
+            })
+            .collect();
+        self.starts.clear();
+        self.starts.push(0);
+        self.neighbours.clear();
+        for (counts, js) in chunks {
+            for c in counts {
+                let last = *self.starts.last().unwrap_or(&0);
+                self.starts.push(last + c);
+            }
+            self.neighbours.extend_from_slice(&js);
+        }
+        self.number_pairs(exerts);
+        self.reference.clear();
+        self.reference.extend_from_slice(x);
+        self.exerts.clear();
+        self.exerts.extend_from_slice(exerts);
+        self.range = range;
+        self.skin = skin;
+        self.builds += 1;
+    }
+
+    /// Slots of the pairs: `i` owns its entries `j > i` when it exerts; an entry `j < i` finds
+    /// its slot in `j`'s (ascending) list by bisection.
+    fn number_pairs(&mut self, exerts: &[bool]) {
+        let n = self.starts.len() - 1;
+        self.upper.clear();
+        self.pair_base.clear();
+        self.pair_base.push(0);
+        for i in 0..n {
+            let own = &self.neighbours[self.starts[i] as usize..self.starts[i + 1] as usize];
+            let up = own.partition_point(|&j| (j as usize) < i);
+            self.upper.push(up as u32);
+            let owned = if exerts[i] { own.len() - up } else { 0 };
+            let last = *self.pair_base.last().unwrap_or(&0);
+            self.pair_base.push(last + owned as u32);
+        }
+        let this = &*self;
+        let slots: Vec<Vec<u32>> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut out = Vec::new();
+                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    let (a, b) = (this.starts[i] as usize, this.starts[i + 1] as usize);
+                    for (k, &j) in this.neighbours[a..b].iter().enumerate() {
+                        let j = j as usize;
+                        out.push(if !exerts[i] {
+                            NO_SLOT
+                        } else if j > i {
+                            this.pair_base[i] + (k as u32 - this.upper[i])
+                        } else {
+                            // i is in j's list (both exert, the test is symmetric)
+                            let (ja, jb) = (this.starts[j] as usize, this.starts[j + 1] as usize);
+                            match this.neighbours[ja..jb].binary_search(&(i as u32)) {
+                                Ok(pos) => this.pair_base[j] + (pos as u32 - this.upper[j]),
+                                Err(_) => NO_SLOT,
+                            }
+                        });
+                    }
+                }
+                out
+            })
+            .collect();
+        self.slots.clear();
+        for s in slots {
+            self.slots.extend_from_slice(&s);
+        }
+    }
+
+    /// Number of pair slots.
+    pub fn pair_count(&self) -> usize {
+        self.pair_base.last().copied().unwrap_or(0) as usize
+    }
+
+    /// The pairs particle `i` owns: its neighbours `j > i` and the slot of the first (the
+    /// others follow consecutively). Empty when `i` does not exert.
+    #[inline]
+    pub fn owned(&self, i: usize) -> (&[u32], usize) {
+        let (Some(&a), Some(&b), Some(&up)) =
+            (self.starts.get(i), self.pair_base.get(i), self.upper.get(i))
+        else {
+            return (&[], 0);
+        };
+        let count = self.pair_base[i + 1] - b;
+        let from = (a + up) as usize;
+        (&self.neighbours[from..from + count as usize], b as usize)
+    }
+
+    /// Slots owned by particles `a..b`.
+    pub fn owned_range(&self, a: usize, b: usize) -> std::ops::Range<usize> {
+        let at = |i: usize| {
+            self.pair_base
+                .get(i.min(self.pair_base.len().saturating_sub(1)))
+                .copied()
+                .unwrap_or(0) as usize
+        };
+        at(a)..at(b)
+    }
+
+    /// Particle `i`'s entries `(j, slot)` in list order (`slot` is [`NO_SLOT`] when `i`
+    /// does not exert).
+    #[inline]
+    pub fn entries(&self, i: usize) -> impl Iterator<Item = (usize, u32)> + '_ {
+        let (a, b) = match (self.starts.get(i), self.starts.get(i + 1)) {
+            (Some(&a), Some(&b)) => (a as usize, b as usize),
+            _ => (0, 0),
+        };
+        self.neighbours[a..b]
+            .iter()
+            .zip(&self.slots[a..b])
+            .map(|(&j, &s)| (j as usize, s))
+    }
+
+    /// Call `f(j, d)` for every listed `j` with `|d| < cutoff`, `d = x_i − x_j`, in the list's
+    /// fixed order (`cutoff` no larger than the range of the last [`VerletList::ensure`]).
+    #[inline]
+    pub fn for_each_neighbour(
+        &self,
+        x: &[DVec3],
+        i: usize,
+        cutoff: f64,
+        mut f: impl FnMut(usize, DVec3),
+    ) {
+        let (Some(&a), Some(&b)) = (self.starts.get(i), self.starts.get(i + 1)) else {
+            return;
+        };
+        let xi = x[i];
+        let c2 = cutoff * cutoff;
+        for &j in &self.neighbours[a as usize..b as usize] {
+            let d = xi - x[j as usize];
+            if d.length_squared() < c2 {
+                f(j as usize, d);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn brute(x: &[DVec3], exerts: &[bool], i: usize, cutoff: f64) -> Vec<usize> {
+        (0..x.len())
+            .filter(|&j| j != i && exerts[j] && (x[i] - x[j]).length() < cutoff)
+            .collect()
+    }
+
+    /// Every pair of exerting particles has one slot, reached from both entries, and the
+    /// owner's `owned` run lists it at that slot.
+    fn check_slots(list: &VerletList, exerts: &[bool]) {
+        let mut seen = vec![0u8; list.pair_count()];
+        for i in 0..exerts.len() {
+            let (owned, base) = list.owned(i);
+            for (j, s) in list.entries(i) {
+                if !exerts[i] {
+                    assert_eq!(s, NO_SLOT);
+                    continue;
+                }
+                seen[s as usize] += 1;
+                if j > i {
+                    assert_eq!(owned[s as usize - base] as usize, j);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 2), "each slot from both sides");
+    }
+
+    #[test]
+    fn a_cached_list_finds_every_pair_until_it_is_rebuilt() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let n = 700;
+        let mut x: Vec<DVec3> = (0..n)
+            .map(|_| {
+                DVec3::new(
+                    rng.random_range(0.0..8.0),
+                    rng.random_range(0.0..8.0),
+                    rng.random_range(0.0..8.0),
+                )
+            })
+            .collect();
+        let mut exerts: Vec<bool> = (0..n).map(|i| i % 9 != 4).collect();
+        let (range, skin) = (1.3, 0.4);
+        let mut list = VerletList::default();
+        let mut rebuilds = 0;
+        for step in 0..60 {
+            if step == 30 {
+                exerts[17] = false; // a capture changes the exerting set
+            }
+            rebuilds += list.ensure(&x, &exerts, range, skin) as usize;
+            check_slots(&list, &exerts);
+            for i in 0..n {
+                let mut got = vec![];
+                list.for_each_neighbour(&x, i, range, |j, d| {
+                    assert_eq!(d, x[i] - x[j]);
+                    got.push(j)
+                });
+                got.sort();
+                assert_eq!(got, brute(&x, &exerts, i, range), "step {step}, i {i}");
+            }
+            for p in x.iter_mut() {
+                *p += DVec3::new(
+                    rng.random_range(-0.05..0.05),
+                    rng.random_range(-0.05..0.05),
+                    rng.random_range(-0.05..0.05),
+                );
+            }
+        }
+        // cached: far fewer builds than evaluations, but more than one (the skin was crossed)
+        assert!(rebuilds > 2 && rebuilds < 30, "{rebuilds}");
+        assert_eq!(list.builds(), rebuilds as u64);
+        // a larger range forces a rebuild; the uncached reference rebuilds every time
+        assert!(list.ensure(&x, &exerts, 1.5, skin));
+        list.rebuild_always = true;
+        assert!(list.ensure(&x, &exerts, 1.5, skin));
+    }
+
+    #[test]
+    fn non_finite_positions_force_a_rebuild_and_are_skipped() {
+        let mut x = vec![DVec3::ZERO, DVec3::X * 0.5, DVec3::X * 5.0];
+        let exerts = vec![true; 3];
+        let mut list = VerletList::default();
+        assert!(list.ensure(&x, &exerts, 1.0, 0.2));
+        x[1] = DVec3::NAN;
+        assert!(list.ensure(&x, &exerts, 1.0, 0.2));
+        let mut seen = vec![];
+        list.for_each_neighbour(&x, 0, 1.0, |j, _| seen.push(j));
+        list.for_each_neighbour(&x, 1, 1.0, |j, _| seen.push(j));
+        assert!(seen.is_empty());
+    }
+}
