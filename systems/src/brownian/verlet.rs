@@ -145,11 +145,11 @@ impl VerletList {
         self.upper.clear();
         self.pair_base.clear();
         self.pair_base.push(0);
-        for i in 0..n {
+        for (i, &exerting) in exerts.iter().enumerate().take(n) {
             let own = &self.neighbours[self.starts[i] as usize..self.starts[i + 1] as usize];
             let up = own.partition_point(|&j| (j as usize) < i);
             self.upper.push(up as u32);
-            let owned = if exerts[i] { own.len() - up } else { 0 };
+            let owned = if exerting { own.len() - up } else { 0 };
             let last = *self.pair_base.last().unwrap_or(&0);
             self.pair_base.push(last + owned as u32);
         }
@@ -158,11 +158,12 @@ impl VerletList {
             .into_par_iter()
             .map(|c| {
                 let mut out = Vec::new();
-                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                let end = ((c + 1) * CHUNK).min(n);
+                for (i, &exerting) in exerts.iter().enumerate().take(end).skip(c * CHUNK) {
                     let (a, b) = (this.starts[i] as usize, this.starts[i + 1] as usize);
                     for (k, &j) in this.neighbours[a..b].iter().enumerate() {
                         let j = j as usize;
-                        out.push(if !exerts[i] {
+                        out.push(if !exerting {
                             NO_SLOT
                         } else if j > i {
                             this.pair_base[i] + (k as u32 - this.upper[i])
@@ -269,10 +270,10 @@ mod tests {
     /// owner's `owned` run lists it at that slot.
     fn check_slots(list: &VerletList, exerts: &[bool]) {
         let mut seen = vec![0u8; list.pair_count()];
-        for i in 0..exerts.len() {
+        for (i, &exerting) in exerts.iter().enumerate() {
             let (owned, base) = list.owned(i);
             for (j, s) in list.entries(i) {
-                if !exerts[i] {
+                if !exerting {
                     assert_eq!(s, NO_SLOT);
                     continue;
                 }
