@@ -31,6 +31,7 @@
 use glam::DVec3;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
 
 use magsep_components::brownian::{BrownianStats, StepControl};
 
@@ -67,13 +68,23 @@ fn normal3(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
 }
 
 /// Wiener increments over `h` for the mobile particles (zero for the others).
+/// Each particle draws from its own stream, so the increments do not depend on the thread
+/// count (parallel from 512 particles).
 pub fn wiener_increments(mobile: &[bool], h: f64, rngs: &mut [Xoshiro256PlusPlus]) -> Vec<DVec3> {
     let s = h.sqrt();
-    mobile
-        .iter()
-        .zip(rngs.iter_mut())
-        .map(|(&m, rng)| if m { normal3(rng) * s } else { DVec3::ZERO })
-        .collect()
+    let draw = |(&m, rng): (&bool, &mut Xoshiro256PlusPlus)| {
+        if m { normal3(rng) * s } else { DVec3::ZERO }
+    };
+    if mobile.len() < 512 {
+        mobile.iter().zip(rngs.iter_mut()).map(draw).collect()
+    } else {
+        mobile
+            .par_iter()
+            .zip(rngs.par_iter_mut())
+            .with_min_len(256)
+            .map(draw)
+            .collect()
+    }
 }
 
 /// Advance `x` by one step `dt` \[s\]. `v0` is the drift at `x` if the caller has it (the ECS

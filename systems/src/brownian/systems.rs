@@ -233,14 +233,26 @@ pub fn prepare_brownian_step(
     stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
 }
 
+/// `set(component, values[k])` for the k-th workspace entity: one linear pass over the query
+/// while it yields the workspace's entities in order (the usual case: particles spawned in
+/// `ParticleId` order share one table), lookups by entity for the rest.
 fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
     ws: &BrownianWorkspace,
     values: &[DVec3],
-    q: &mut Query<&mut T>,
+    q: &mut Query<(Entity, &mut T)>,
     set: impl Fn(&mut T, DVec3),
 ) {
-    for (e, v) in ws.entities.iter().zip(values) {
-        if let Ok(mut c) = q.get_mut(*e) {
+    let n = ws.entities.len().min(values.len());
+    let mut k = 0;
+    for (e, mut c) in q.iter_mut() {
+        if k >= n || ws.entities[k] != e {
+            break;
+        }
+        set(&mut c, values[k]);
+        k += 1;
+    }
+    for (e, v) in ws.entities[k..n].iter().zip(&values[k..n]) {
+        if let Ok((_, mut c)) = q.get_mut(*e) {
             set(&mut c, *v);
         }
     }
@@ -249,8 +261,8 @@ fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
 /// Field forces and moments (computed in `Prepare` with the moments the dipole forces need).
 pub fn compute_field_forces(
     ws: Res<BrownianWorkspace>,
-    mut forces: Query<&mut FieldForce>,
-    mut moments: Query<&mut MagneticMoment>,
+    mut forces: Query<(Entity, &mut FieldForce)>,
+    mut moments: Query<(Entity, &mut MagneticMoment)>,
 ) {
     write_dense(&ws, &ws.field, &mut forces, |c, v| c.0 = v);
     write_dense(&ws, &ws.moments, &mut moments, |c, v| c.0 = v);
@@ -278,7 +290,7 @@ fn pair_forces(
 pub fn compute_dipole_forces(
     ws: Res<BrownianWorkspace>,
     config: Res<BrownianConfig>,
-    mut forces: Query<&mut DipoleForce>,
+    mut forces: Query<(Entity, &mut DipoleForce)>,
 ) {
     let f = pair_forces(&ws, &config, |view, out| {
         ws.model
@@ -291,7 +303,7 @@ pub fn compute_dipole_forces(
 pub fn compute_contact_forces(
     ws: Res<BrownianWorkspace>,
     config: Res<BrownianConfig>,
-    mut forces: Query<&mut ContactForce>,
+    mut forces: Query<(Entity, &mut ContactForce)>,
 ) {
     let f = pair_forces(&ws, &config, |view, out| {
         ws.model.contact_forces(&ws.positions, view, &ws.lists, out)
@@ -347,20 +359,32 @@ pub fn integrate_brownian(
     mut stats: ResMut<BrownianStats>,
     mut health: ResMut<Health>,
     kernels: Option<Res<ExternalForces>>,
-    forces: Query<ForceRow>,
+    forces: Query<(Entity, ForceRow)>,
 ) {
     let ws = &mut *ws;
     let n = ws.positions.len();
     let mut net = vec![DVec3::ZERO; n];
     let mut extra = vec![DVec3::ZERO; n];
-    for (k, e) in ws.entities.iter().enumerate() {
-        if let Ok((f, a, b, c, kf)) = forces.get(*e) {
-            let model = a.map(|v| v.0).unwrap_or_default()
-                + b.map(|v| v.0).unwrap_or_default()
-                + c.map(|v| v.0).unwrap_or_default()
-                + kf.map(|v| v.force).unwrap_or_default();
-            net[k] = f.0;
-            extra[k] = f.0 - model;
+    let mut split = |k: usize, (f, a, b, c, kf): ForceRow| {
+        let model = a.map(|v| v.0).unwrap_or_default()
+            + b.map(|v| v.0).unwrap_or_default()
+            + c.map(|v| v.0).unwrap_or_default()
+            + kf.map(|v| v.force).unwrap_or_default();
+        net[k] = f.0;
+        extra[k] = f.0 - model;
+    };
+    // a linear pass while the query follows the workspace order, lookups for the rest
+    let mut k = 0;
+    for (e, row) in forces.iter() {
+        if k >= n || ws.entities[k] != e {
+            break;
+        }
+        split(k, row);
+        k += 1;
+    }
+    for (k, e) in ws.entities.iter().enumerate().skip(k) {
+        if let Ok((_, row)) = forces.get(*e) {
+            split(k, row);
         }
     }
     let mut dynamics = PipelineDynamics {
@@ -421,15 +445,28 @@ pub fn integrate_brownian(
 /// Copy positions, capture flags and random streams to the components.
 pub fn write_back_brownian(
     ws: Res<BrownianWorkspace>,
-    mut q: Query<(&mut Position, Option<&mut Captured>, &mut ParticleRng)>,
+    mut q: Query<(Entity, &mut Position, Option<&mut Captured>, &mut ParticleRng)>,
 ) {
-    for (k, e) in ws.entities.iter().enumerate() {
-        if let Ok((mut p, c, mut r)) = q.get_mut(*e) {
-            p.0 = ws.positions[k];
-            if let Some(mut c) = c {
-                c.0 = ws.captured[k];
-            }
-            r.0.clone_from(&ws.rngs[k]);
+    let write = |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>, mut r: Mut<ParticleRng>| {
+        p.0 = ws.positions[k];
+        if let Some(mut c) = c {
+            c.0 = ws.captured[k];
+        }
+        r.0.clone_from(&ws.rngs[k]);
+    };
+    // a linear pass while the query follows the workspace order, lookups for the rest
+    let n = ws.entities.len();
+    let mut k = 0;
+    for (e, p, c, r) in q.iter_mut() {
+        if k >= n || ws.entities[k] != e {
+            break;
+        }
+        write(k, p, c, r);
+        k += 1;
+    }
+    for (k, e) in ws.entities.iter().enumerate().skip(k) {
+        if let Ok((_, p, c, r)) = q.get_mut(*e) {
+            write(k, p, c, r);
         }
     }
 }
