@@ -203,6 +203,8 @@ pub enum BenchKind {
     Field,
     /// Brownian dynamics without and with hydrodynamics.
     Brownian,
+    /// Brownian dynamics on the configuration of the LAMMPS peer only (`lammps_mirror` rows).
+    BrownianPeer,
     /// The history force and the particle-fluid pipeline.
     ParticleFluid,
     /// The channel-flow solver of the coupled liquid and the coupling per particle.
@@ -257,6 +259,9 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         BenchKind::Field => return crate::studies::bench_field::bench_field(as_json, quick),
         BenchKind::Brownian => {
             return crate::studies::bench_brownian::bench_brownian(as_json, quick);
+        }
+        BenchKind::BrownianPeer => {
+            return crate::studies::bench_brownian::bench_brownian_peer(as_json, quick);
         }
         BenchKind::ParticleFluid => {
             return crate::studies::fluid_charts::bench_particle_fluid(as_json, quick);

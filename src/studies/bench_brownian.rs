@@ -215,40 +215,7 @@ pub fn bench_brownian_with(
             last_positions = x;
         }
     }
-    // (a') the configuration of the LAMMPS peer (anchor-bench `lammps_bd.sh`)
-    if sizes.mirror_ncell > 0 {
-        let text = lammps_mirror_scene(sizes.mirror_ncell, 1)?;
-        let scene = crate::scene::parse_scene(&text, &Default::default())
-            .map_err(|e| BenchError::Runtime(format!("mirror scene: {e}")))?;
-        let mirror_n = sizes.mirror_ncell.pow(3);
-        for &threads in &sizes.threads {
-            let (r, _) =
-                pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
-            emit(
-                &mut rows,
-                as_json,
-                json!({
-                    "name": "brownian_lammps_mirror",
-                    "bench": "brownian",
-                    "case": "lammps_mirror",
-                    "threads": threads,
-                    "n": mirror_n,
-                    "reduced_density": lammps_case::REDUCED_DENSITY,
-                    "dipole_cutoff_sigma": lammps_case::CUTOFF_SIGMA,
-                    "core": "Mie(12,6) = WCA, epsilon = kT",
-                    "dt_s": lammps_case::dt_and_moment().0,
-                    "steps": r.steps,
-                    "wall_time_s": r.seconds,
-                    "particle_steps_per_s": r.particle_steps_per_s,
-                    "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
-                    "peer": {"impl": "lammps", "case": "bd_dipoles", "threads": 1,
-                             "metric": "particle_steps_per_s"},
-                    "differs": "moments held along the field (no rotation); unbounded domain",
-                    "load_average_1min": load_average(),
-                }),
-            )?;
-        }
-    }
+    mirror_rows(sizes, as_json, &mut rows)?;
     let rc = DIPOLE_CUTOFF * RADIUS;
     let initial = pipeline::initial_positions(n, 1)?;
     emit(
@@ -317,6 +284,63 @@ pub fn bench_brownian_with(
         }
     }
     Ok(rows)
+}
+
+/// The LAMMPS-mirror rows (the configuration of anchor-bench `lammps_bd.sh`, see
+/// [`lammps_mirror_scene`]) at `sizes.mirror_ncell` and `sizes.threads`.
+fn mirror_rows(
+    sizes: &BrownianBenchSizes,
+    as_json: bool,
+    rows: &mut Vec<Value>,
+) -> Result<(), BenchError> {
+if sizes.mirror_ncell > 0 {
+    let text = lammps_mirror_scene(sizes.mirror_ncell, 1)?;
+    let scene = crate::scene::parse_scene(&text, &Default::default())
+        .map_err(|e| BenchError::Runtime(format!("mirror scene: {e}")))?;
+    let mirror_n = sizes.mirror_ncell.pow(3);
+    for &threads in &sizes.threads {
+        let (r, _) =
+            pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
+        emit(
+            rows,
+            as_json,
+            json!({
+                "name": "brownian_lammps_mirror",
+                "bench": "brownian",
+                "case": "lammps_mirror",
+                "threads": threads,
+                "n": mirror_n,
+                "reduced_density": lammps_case::REDUCED_DENSITY,
+                "dipole_cutoff_sigma": lammps_case::CUTOFF_SIGMA,
+                "core": "Mie(12,6) = WCA, epsilon = kT",
+                "dt_s": lammps_case::dt_and_moment().0,
+                "steps": r.steps,
+                "wall_time_s": r.seconds,
+                "particle_steps_per_s": r.particle_steps_per_s,
+                "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
+                "peer": {"impl": "lammps", "case": "bd_dipoles", "threads": 1,
+                         "metric": "particle_steps_per_s"},
+                "differs": "moments held along the field (no rotation); unbounded domain",
+                "load_average_1min": load_average(),
+            }),
+        )?;
+    }
+}
+Ok(())
+}
+
+/// `magsep bench brownian-peer`: only the LAMMPS-mirror rows (22³ = 10 648 particles, 1 and 2
+/// threads, ~3 s each; `quick`: 6³, 0.5 s), for running right beside the peer.
+///
+/// # Errors
+/// As [`bench_brownian`].
+pub fn bench_brownian_peer(as_json: bool, quick: bool) -> Result<(), BenchError> {
+    let mut sizes = BrownianBenchSizes::full();
+    if quick {
+        sizes.mirror_ncell = 6;
+        sizes.pipeline_seconds = 0.5;
+    }
+    mirror_rows(&sizes, as_json, &mut Vec::new())
 }
 
 /// `magsep chart brownian-cost --out DIR [--quick]`: writes `DIR/brownian_mobility_cost.svg`

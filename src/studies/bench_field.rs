@@ -151,7 +151,8 @@ pub fn bench_field(as_json: bool, quick: bool) -> Result<(), BenchError> {
             emit(
                 &mut rows,
                 as_json,
-                json!({"name": "field_anchor", "case": case, "threads": threads, "points": n, "points_per_s": pps, "checksum": checksum}),
+                json!({"name": "field_anchor", "case": case, "threads": threads, "points": n, "points_per_s": pps, "checksum": checksum,
+                        "peer": {"impl": "magba", "case": case, "threads": threads, "metric": "points_per_s_best"}}),
             )?;
         }
     }
