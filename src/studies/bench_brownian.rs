@@ -293,40 +293,40 @@ fn mirror_rows(
     as_json: bool,
     rows: &mut Vec<Value>,
 ) -> Result<(), BenchError> {
-if sizes.mirror_ncell > 0 {
-    let text = lammps_mirror_scene(sizes.mirror_ncell, 1)?;
-    let scene = crate::scene::parse_scene(&text, &Default::default())
-        .map_err(|e| BenchError::Runtime(format!("mirror scene: {e}")))?;
-    let mirror_n = sizes.mirror_ncell.pow(3);
-    for &threads in &sizes.threads {
-        let (r, _) =
-            pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
-        emit(
-            rows,
-            as_json,
-            json!({
-                "name": "brownian_lammps_mirror",
-                "bench": "brownian",
-                "case": "lammps_mirror",
-                "threads": threads,
-                "n": mirror_n,
-                "reduced_density": lammps_case::REDUCED_DENSITY,
-                "dipole_cutoff_sigma": lammps_case::CUTOFF_SIGMA,
-                "core": "Mie(12,6) = WCA, epsilon = kT",
-                "dt_s": lammps_case::dt_and_moment().0,
-                "steps": r.steps,
-                "wall_time_s": r.seconds,
-                "particle_steps_per_s": r.particle_steps_per_s,
-                "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
-                "peer": {"impl": "lammps", "case": "bd_dipoles", "threads": 1,
-                         "metric": "particle_steps_per_s"},
-                "differs": "moments held along the field (no rotation); unbounded domain",
-                "load_average_1min": load_average(),
-            }),
-        )?;
+    if sizes.mirror_ncell > 0 {
+        let text = lammps_mirror_scene(sizes.mirror_ncell, 1)?;
+        let scene = crate::scene::parse_scene(&text, &Default::default())
+            .map_err(|e| BenchError::Runtime(format!("mirror scene: {e}")))?;
+        let mirror_n = sizes.mirror_ncell.pow(3);
+        for &threads in &sizes.threads {
+            let (r, _) =
+                pipeline_rate(&scene, threads, sizes.warmup_steps, sizes.pipeline_seconds)?;
+            emit(
+                rows,
+                as_json,
+                json!({
+                    "name": "brownian_lammps_mirror",
+                    "bench": "brownian",
+                    "case": "lammps_mirror",
+                    "threads": threads,
+                    "n": mirror_n,
+                    "reduced_density": lammps_case::REDUCED_DENSITY,
+                    "dipole_cutoff_sigma": lammps_case::CUTOFF_SIGMA,
+                    "core": "Mie(12,6) = WCA, epsilon = kT",
+                    "dt_s": lammps_case::dt_and_moment().0,
+                    "steps": r.steps,
+                    "wall_time_s": r.seconds,
+                    "particle_steps_per_s": r.particle_steps_per_s,
+                    "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
+                    "peer": {"impl": "lammps", "case": "bd_dipoles", "threads": 1,
+                             "metric": "particle_steps_per_s"},
+                    "differs": "moments held along the field (no rotation); unbounded domain",
+                    "load_average_1min": load_average(),
+                }),
+            )?;
+        }
     }
-}
-Ok(())
+    Ok(())
 }
 
 /// `magsep bench brownian-peer`: only the LAMMPS-mirror rows (22³ = 10 648 particles, 1 and 2

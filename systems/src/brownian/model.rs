@@ -420,4 +420,48 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn cached_lists_give_the_forces_of_fresh_lists_bit_for_bit() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
+        let n = 600;
+        let a = 75e-9;
+        let mut x: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 3e-6)
+            .collect();
+        let model = ForceModel {
+            sources: Vec::new(),
+            b_ext: DVec3::new(0.3, 0.0, 1.0),
+            tolerance: 1e-6,
+            kt: 4e-21,
+            mie: Some(Mie::new(4e-19, 30.0, 15.0)),
+            dipole_cutoff: Some(10.0),
+        };
+        let laws = vec![MomentModel::Saturated { moment: 1e-16 }; n];
+        let (radii, mobile) = (vec![a; n], vec![true; n]);
+        let view = ParticleView {
+            radii: &radii,
+            moments: &laws,
+            mobile: &mobile,
+            exerts: &mobile,
+        };
+        let (mut cached, mut fresh) = (PairLists::default(), PairLists::default());
+        fresh.set_rebuild_always(true);
+        let (mut pc, mut pf) = (ForceParts::zeros(n), ForceParts::zeros(n));
+        for _ in 0..40 {
+            model.evaluate(&x, &view, &mut cached, &mut pc);
+            model.evaluate(&x, &view, &mut fresh, &mut pf);
+            assert_eq!(pc, pf);
+            for p in x.iter_mut() {
+                *p += DVec3::new(rng.random(), rng.random(), rng.random()) * 8e-9 - 4e-9;
+            }
+        }
+        assert!(pc.dipole.iter().any(|f| *f != DVec3::ZERO));
+        assert!(
+            cached.builds() > 2 && cached.builds() < 40,
+            "{}",
+            cached.builds()
+        );
+        assert_eq!(fresh.builds(), 80);
+    }
 }

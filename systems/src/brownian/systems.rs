@@ -445,15 +445,21 @@ pub fn integrate_brownian(
 /// Copy positions, capture flags and random streams to the components.
 pub fn write_back_brownian(
     ws: Res<BrownianWorkspace>,
-    mut q: Query<(Entity, &mut Position, Option<&mut Captured>, &mut ParticleRng)>,
+    mut q: Query<(
+        Entity,
+        &mut Position,
+        Option<&mut Captured>,
+        &mut ParticleRng,
+    )>,
 ) {
-    let write = |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>, mut r: Mut<ParticleRng>| {
-        p.0 = ws.positions[k];
-        if let Some(mut c) = c {
-            c.0 = ws.captured[k];
-        }
-        r.0.clone_from(&ws.rngs[k]);
-    };
+    let write =
+        |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>, mut r: Mut<ParticleRng>| {
+            p.0 = ws.positions[k];
+            if let Some(mut c) = c {
+                c.0 = ws.captured[k];
+            }
+            r.0.clone_from(&ws.rngs[k]);
+        };
     // a linear pass while the query follows the workspace order, lookups for the rest
     let n = ws.entities.len();
     let mut k = 0;
