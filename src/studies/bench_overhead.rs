@@ -12,13 +12,16 @@
 //!   `recording_overhead`: the wall times, the time spent writing frames (measured inside the
 //!   recorder, [`RecordTiming`]) and closing the file, and `overhead_fraction`: that time over
 //!   the time of the steps, extrapolated to the scene's full run (`frames_full_run` frames:
-//!   one every `every` steps plus the first and the last) where the pipeline knows its length.
+//!   one every `every` steps plus the first and the last) where the pipeline knows its length
+//!   (else over the timed window): `frames_overhead_fraction` counts the frames only,
+//!   `overhead_fraction` also the one-off closing of the file (`finish_s`: summary, footer and
+//!   the `fsync`, which dominates runs of a few hundredths of a second).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use magsep_plugins::recorder::{RecordTiming, record_now};
-use serde_json::{Value, json};
+use serde_json::json;
 
 use crate::scene::{ExecutorChoice, RecordEvery, Registry, Scene, parse_scene};
 use crate::sim::Simulation;
@@ -246,15 +249,17 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
         let step_s = (rec.wall_s - recording_s).max(1e-12) / rec.steps.max(1) as f64;
         let frame_s = rec.record_s / rec.frames.max(1) as f64;
         let total = scene.pipeline.as_ref().and_then(|p| p.total_steps(&scene));
-        let (frames_full, fraction_full) = match total {
+        let window_fraction = recording_s / (rec.wall_s - recording_s).max(1e-12);
+        let window_frames = rec.record_s / (rec.wall_s - recording_s).max(1e-12);
+        let (frames_full, fraction_full, frames_fraction) = match total {
             Some(t) if t > 0 => {
                 let frames = t / every.max(1) + 2;
-                let cost = frames as f64 * frame_s + rec.finish_s;
-                (Value::from(frames), Value::from(cost / (t as f64 * step_s)))
+                let run = t as f64 * step_s;
+                let cost = frames as f64 * frame_s;
+                (frames, (cost + rec.finish_s) / run, cost / run)
             }
-            _ => (Value::Null, Value::Null),
+            _ => (rec.frames, window_fraction, window_frames),
         };
-        let window_fraction = recording_s / (rec.wall_s - recording_s).max(1e-12);
         emit(
             &mut rows,
             as_json,
@@ -268,7 +273,8 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                    "step_s": step_s,
                    "window_overhead_fraction": window_fraction,
                    "full_run_steps": total, "frames_full_run": frames_full,
-                   "overhead_fraction": fraction_full.clone().as_f64().map_or(Value::from(window_fraction), Value::from)}),
+                   "frames_overhead_fraction": frames_fraction,
+                   "overhead_fraction": fraction_full}),
         )?;
     }
     Ok(())
