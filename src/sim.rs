@@ -10,9 +10,7 @@ use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
-use magsep_plugins::record::{
-    FibreShape, FrameBuffering, PluginInfo, RecordingMetadata, RecordingWriter,
-};
+use magsep_plugins::record::{FibreShape, PluginInfo, RecordingMetadata, RecordingWriter};
 use magsep_plugins::recorder::{Recorder, record_now, recording_error};
 use serde_json::Value;
 
@@ -347,8 +345,6 @@ fn open_recording(
         extra: Default::default(),
     };
     let mut writer = RecordingWriter::create(path, &meta)?;
-    // frames of small scenes arrive every few hundred microseconds: let them share chunks
-    writer.buffer_frames(Some(FrameBuffering::default()));
     let mut fibres: Vec<_> = app
         .world
         .query::<(&FibreId, &Fibre)>()
