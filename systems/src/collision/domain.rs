@@ -51,7 +51,7 @@ impl PeriodicAxis {
 #[inline]
 fn round_half_away(x: f64) -> f64 {
     // 2^52: from here on every f64 is an integer
-    if !(x.abs() < 4_503_599_627_370_496.0) {
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
         return x;
     }
     // exact: |x| < 2^52 fits an i64, and x − trunc(x) is exact
