@@ -141,8 +141,11 @@ pub enum ExecutorChoice {
     MultiThreaded,
 }
 
-/// Particle count from which [`ExecutorChoice::Auto`] uses the multi-threaded executor.
-pub const SMALL_SCENE_PARTICLES: usize = 4096;
+/// Particle count from which [`ExecutorChoice::Auto`] uses the multi-threaded executor: the
+/// count from which per-particle loops go parallel too (`magsep_systems::par`). Below it a
+/// step's work is a few microseconds, less than handing each system to a worker costs; at
+/// 1000 spheres both executors take the same time (`magsep bench overhead`).
+pub const SMALL_SCENE_PARTICLES: usize = 256;
 
 impl ExecutorChoice {
     /// Whether a scene of `particles` particles runs multi-threaded.
