@@ -15,8 +15,8 @@ use magsep_plugins::recorder::{Recorder, record_now, recording_error};
 use serde_json::Value;
 
 pub use crate::error::SimError;
-pub use crate::scene::RunOptions;
 pub use crate::scene::pipeline::StopFlag;
+pub use crate::scene::{ExecutorChoice, RunOptions};
 use crate::scene::{NoProgress, Pipeline, Progress, RecordEvery, RunInfo, Scene, spawn_scene};
 
 /// A simulation built from a scene.
@@ -95,6 +95,13 @@ impl SimulationBuilder<'_> {
         self
     }
 
+    /// How the schedule runs its systems (default: by the scene's size, see
+    /// [`ExecutorChoice`]).
+    pub fn executor(mut self, executor: ExecutorChoice) -> Self {
+        self.options.executor = executor;
+        self
+    }
+
     /// Spawn the scene, build the schedule, open the recording.
     ///
     /// # Errors
@@ -124,11 +131,16 @@ impl Simulation {
         };
         let seed = options.seed.unwrap_or(simulation.seed);
         let mut app = SimApp::new();
-        if options.single_threaded {
+        spawn_scene(scene, &mut app.world, seed)?;
+        let particles = app
+            .world
+            .query_filtered::<(), With<ParticleId>>()
+            .iter(&app.world)
+            .count();
+        if options.single_threaded || !options.executor.multi_threaded(particles) {
             app.schedule
                 .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
         }
-        spawn_scene(scene, &mut app.world, seed)?;
         if let Some(frame) = &options.resume_from {
             pipeline
                 .apply_frame(&mut app.world, frame)

@@ -60,6 +60,17 @@ pub fn recording_error(world: &World) -> Option<&str> {
         .and_then(|r| r.error.as_deref())
 }
 
+/// Wall time spent writing frames (a resource, present only when a caller measures the
+/// recording's cost, e.g. `magsep bench recording`): [`record_now`] adds the time it takes to
+/// gather, encode and write each frame.
+#[derive(Resource, Debug, Clone, Copy, Default, PartialEq)]
+pub struct RecordTiming {
+    /// Time spent in [`record_now`] writing frames \[s\].
+    pub seconds: f64,
+    /// Frames written.
+    pub frames: u64,
+}
+
 /// A function giving one key of a frame's status (`None`: leave the key out).
 pub type StatusFn = fn(&World) -> Option<Value>;
 
@@ -184,6 +195,7 @@ pub fn record_now(world: &mut World) {
     if rec.writer.is_none() || rec.last_step == step {
         return;
     }
+    let started = std::time::Instant::now();
     let frame = gather_frame(world);
     let colours: Option<Vec<[f32; 4]>> = world
         .get_resource::<ColourProvider>()
@@ -202,6 +214,10 @@ pub fn record_now(world: &mut World) {
     match result {
         Some(Err(e)) => rec.fail(format!("frame at step {}: {e}", frame.step)),
         _ => rec.last_step = Some(frame.step),
+    }
+    if let Some(mut t) = world.get_resource_mut::<RecordTiming>() {
+        t.seconds += started.elapsed().as_secs_f64();
+        t.frames += 1;
     }
 }
 

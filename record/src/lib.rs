@@ -101,7 +101,7 @@ pub use reader::{
     read_last_frame, read_recording, read_recording_bytes, trailing_message,
 };
 pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
-pub use writer::{ChannelHandle, RecordingSink, RecordingWriter, log_time_ns};
+pub use writer::{ChannelHandle, FrameBuffering, RecordingSink, RecordingWriter, log_time_ns};
 
 /// Topic of the lossless particle state channel (schema `magsep.ParticleState`).
 pub const STATE_TOPIC: &str = "/state";

@@ -37,7 +37,8 @@ pub use crate::error::{SceneError, SceneErrors, SpawnError};
 pub use fibre_packing::FibrePackingSpec;
 pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use pipeline::{
-    NoProgress, ParseContext, Pipeline, Progress, Registry, RunInfo, RunOptions, SceneSection,
+    ExecutorChoice, NoProgress, ParseContext, Pipeline, Progress, Registry, RunInfo, RunOptions,
+    SceneSection,
 };
 pub use placement::{DensityRatios, PlacementSpec};
 pub use sections::{

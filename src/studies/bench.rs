@@ -209,6 +209,12 @@ pub enum BenchKind {
     ParticleFluid,
     /// The channel-flow solver of the coupled liquid and the coupling per particle.
     Fluid,
+    /// Framework overhead: wall time per step of a simple particle-fluid scene against N.
+    Overhead,
+    /// Recording overhead of each pipeline's representative scene at its `record.every`.
+    Recording,
+    /// Only the dense settling bed rows of `particle-fluid` (10⁴ spheres with collisions).
+    SettlingBed,
 }
 
 /// The charts of `magsep chart`.
@@ -267,6 +273,15 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
             return crate::studies::fluid_charts::bench_particle_fluid(as_json, quick);
         }
         BenchKind::Fluid => return crate::studies::liquid::bench::bench_fluid(as_json, quick),
+        BenchKind::Overhead => {
+            return crate::studies::bench_overhead::bench_overhead(as_json, quick);
+        }
+        BenchKind::Recording => {
+            return crate::studies::bench_overhead::bench_recording(as_json, quick);
+        }
+        BenchKind::SettlingBed => {
+            return crate::studies::fluid_charts::bench_settling_bed(as_json, quick);
+        }
         BenchKind::Packing => {}
     }
     let threads = rayon::current_num_threads();

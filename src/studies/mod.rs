@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod bench_brownian;
 pub mod bench_field;
+pub mod bench_overhead;
 pub mod bench_scene;
 pub mod brownian_chart;
 pub mod brownian_sweep;

@@ -14,6 +14,7 @@
 //! * [`packing`]: the mechanical contraction method.
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
+//! * [`par`]: per-entity loops that go parallel only with enough entities.
 
 #![warn(missing_docs)]
 
@@ -26,6 +27,7 @@ pub mod fluid;
 pub mod forces;
 pub mod geometry;
 pub mod packing;
+pub mod par;
 pub mod rng;
 pub mod sets;
 

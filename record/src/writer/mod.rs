@@ -23,6 +23,7 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Where a recording's bytes go: a [`File`], or any seekable sink (an in-memory buffer, or in
 /// tests one that fails like a full disk), see [`RecordingWriter::from_sink`].
@@ -74,7 +75,8 @@ pub fn log_time_ns(frame: &ParticleFrame) -> u64 {
 /// ([`add_metadata`](Self::add_metadata)) that plugins add.
 ///
 /// Every call that writes data (a frame, a message or a batch of messages, a metadata record,
-/// a channel) ends the current chunk and flushes the file, so a process killed at any point
+/// a channel) ends the current chunk and flushes the file (frames may instead share chunks for
+/// up to a bounded time, see [`buffer_frames`](Self::buffer_frames)), so a process killed at any point
 /// leaves a file whose finished frames and messages [`read_recording`](crate::read_recording)
 /// and [`RecordingReader`](crate::RecordingReader) recover. [`finish`](Self::finish) writes the summary section and footer; dropping an
 /// unfinished writer does the same on a best-effort basis (errors are ignored, nothing panics).
@@ -97,6 +99,33 @@ pub struct RecordingWriter {
     channels: Vec<AddedChannel>,
     /// Largest chunk a frame may take ([`MAX_CHUNK_BYTES`]; smaller in tests).
     pub(crate) max_chunk: u64,
+    /// Frame buffering ([`RecordingWriter::buffer_frames`]); `None`: every frame ends its chunk.
+    buffering: Option<FrameBuffering>,
+    /// Message bytes written since the last flush.
+    pending: u64,
+    /// When the last flush happened.
+    last_flush: Instant,
+    /// When the last frame was written.
+    last_frame: Option<Instant>,
+}
+
+/// How long frames may wait in the open chunk (see [`RecordingWriter::buffer_frames`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameBuffering {
+    /// Flush once the open chunk holds this many message bytes (uncompressed).
+    pub max_bytes: u64,
+    /// Flush at the first frame written this long after the last flush.
+    pub max_wait: Duration,
+}
+
+impl Default for FrameBuffering {
+    /// 1 MiB or 1 s, whichever comes first.
+    fn default() -> Self {
+        Self {
+            max_bytes: 1 << 20,
+            max_wait: Duration::from_secs(1),
+        }
+    }
 }
 
 impl RecordingWriter {
@@ -125,7 +154,11 @@ impl RecordingWriter {
             .compression(Some(mcap::Compression::Zstd))
             .library(format!("magsep-record/{}", env!("CARGO_PKG_VERSION")))
             // Chunks end at every flush, i.e. once per frame.
-            .chunk_size(None);
+            .chunk_size(None)
+            // Compress on the calling thread: the crate's default (a zstd worker per physical
+            // core) hands every chunk to a worker and waits for it, which cost a one-particle
+            // frame ~100 µs of thread wake-ups, more than the compression itself.
+            .compression_threads(0);
         let mut writer = Self {
             mcap: None,
             path: path.to_path_buf(),
@@ -137,6 +170,10 @@ impl RecordingWriter {
             decor: SceneDecor::default(),
             channels: Vec::new(),
             max_chunk: MAX_CHUNK_BYTES,
+            buffering: None,
+            pending: 0,
+            last_flush: Instant::now(),
+            last_frame: None,
         };
         let mut mcap = options
             .create(BufWriter::new(sink))
@@ -168,6 +205,19 @@ impl RecordingWriter {
         Ok(writer)
     }
 
+    /// Let frames that arrive fast share chunks: [`write_frame`](Self::write_frame) then ends
+    /// the chunk (one zstd frame and one write to the file) only once `policy.max_bytes` of
+    /// messages are pending, `policy.max_wait` has passed since the last flush, or the frame
+    /// came `policy.max_wait` or more after the previous one (the first frame and slow frames
+    /// are written at once), instead of at every frame. Small frames (a few particles) then
+    /// cost a fraction of the time. Every other write (metadata, channels,
+    /// [`finish`](Self::finish), dropping the writer) still flushes at once, the pending frames
+    /// included; a process killed without finishing loses only frames that came less than
+    /// `max_wait` after the last flush. `None` restores one chunk per frame (the default).
+    pub fn buffer_frames(&mut self, policy: Option<FrameBuffering>) {
+        self.buffering = policy;
+    }
+
     /// The file being written.
     pub fn path(&self) -> &Path {
         &self.path
@@ -180,7 +230,7 @@ impl RecordingWriter {
 
     /// Writes `frame` as one message on [`STATE_TOPIC`] and one on [`SCENE_TOPIC`], both with log
     /// and publish time [`log_time_ns`] (clamped to be non-decreasing), then ends the chunk and
-    /// flushes the file.
+    /// flushes the file (unless frames are buffered, see [`buffer_frames`](Self::buffer_frames)).
     ///
     /// `colours` gives each particle's RGBA colour (components in 0..1) in the scene, in the
     /// frame's particle order; `None` uses a default colour. Fails with
@@ -227,11 +277,25 @@ impl RecordingWriter {
                 ),
             });
         }
+        // a chunk never grows past what readers accept: flush the frames pending first
+        if self.pending > 0 && self.pending + chunk > self.max_chunk {
+            self.flush()?;
+        }
         self.write_buf(self.state_channel, sequence, log_time)?;
         self.buf = scene;
         self.write_buf(self.scene_channel, sequence, log_time)?;
-
-        self.flush()?;
+        self.pending += chunk;
+        let now = Instant::now();
+        let slow = self.last_frame.is_none_or(|t| {
+            now.duration_since(t) >= self.buffering.map_or(Duration::ZERO, |b| b.max_wait)
+        });
+        self.last_frame = Some(now);
+        let due = self.buffering.is_none_or(|b| {
+            slow || self.pending >= b.max_bytes || now.duration_since(self.last_flush) >= b.max_wait
+        });
+        if due {
+            self.flush()?;
+        }
         self.last_log_time = Some(log_time);
         self.frames_written += 1;
         Ok(())
@@ -332,6 +396,8 @@ impl RecordingWriter {
 
     /// Ends the current chunk and flushes the `BufWriter` to the file (see `mcap::Writer::flush`).
     pub(crate) fn flush(&mut self) -> Result<(), RecordError> {
+        self.pending = 0;
+        self.last_flush = Instant::now();
         let result = self.mcap().flush();
         result.map_err(|e| self.write_error(e))
     }

@@ -78,6 +78,7 @@ pub fn run_ensemble(
             record: if k == 0 { options.record.clone() } else { None },
             pipeline: options.pipeline.clone(),
             single_threaded: options.single_threaded || runs > 1,
+            executor: options.executor,
             resume_from: None,
             plugins: options.plugins.clone(),
             stop: Some(stop.clone()),

@@ -142,6 +142,14 @@ pub fn bench_particle_fluid(as_json: bool, quick: bool) -> Result<(), BenchError
     Ok(())
 }
 
+/// `magsep bench settling-bed [--json] [--quick]`: only the settling-bed rows.
+///
+/// # Errors
+/// [`BenchError::Runtime`] when the scene cannot be built.
+pub fn bench_settling_bed(as_json: bool, quick: bool) -> Result<(), BenchError> {
+    collision_bed_row(&mut Vec::new(), as_json, quick)
+}
+
 /// History cost per particle-step for full memory and the 389-step window + tail.
 fn history_rows(rows: &mut Vec<Value>, as_json: bool, quick: bool) -> Result<(), BenchError> {
     let (sizes, many): (&[usize], usize) = if quick {

@@ -22,7 +22,7 @@ mod levitation;
 pub(crate) mod separation;
 mod spheroid_model;
 
-pub use bench::bench_particle_fluid;
+pub use bench::{bench_particle_fluid, bench_settling_bed};
 pub use collisions::chart_collisions;
 pub use flake_collisions::chart_flake_collisions;
 pub use flakes::chart_flakes;

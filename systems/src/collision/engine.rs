@@ -333,16 +333,19 @@ impl Sim<'_, '_> {
         }
     }
 
+    #[inline]
     fn position_at(&self, i: usize, t: f64) -> DVec3 {
         self.p.positions[i] + self.p.velocities[i] * (t - self.eng.local_time[i])
     }
 
+    #[inline]
     fn advance(&mut self, i: usize, t: f64) {
         self.p.positions[i] = self.position_at(i, t);
         self.advance_orientation(i, t);
         self.eng.local_time[i] = t;
     }
 
+    #[inline]
     fn capped(&self, i: usize) -> bool {
         self.eng.count[i] >= self.cfg.max_events_per_particle
     }

@@ -76,7 +76,7 @@ pub fn compute_spheroid_rotational_drag(
         &mut RotationalDragTorque,
     )>,
 ) {
-    q.par_iter_mut().for_each(|(w, s, sp, mut t)| {
+    crate::par_for_each_mut!(q, |(w, s, sp, mut t)| {
         let (torque, k) = rotational_resistance(&sp.hydro, 0.5 * s.vorticity - w.0);
         t.torque = torque;
         t.stiffness = k;
@@ -89,7 +89,7 @@ pub fn compute_magnetic_torque(
     mut q: Query<(&Position, &Orientation, &SpheroidFluid, &mut MagneticTorque)>,
 ) {
     let chi = cfg.liquid.susceptibility;
-    q.par_iter_mut().for_each(|(x, o, sp, mut t)| {
+    crate::par_for_each_mut!(q, |(x, o, sp, mut t)| {
         let curvature = cfg
             .magnet
             .static_pressure_curvature(chi, cfg.magnet_y(x.0.z));

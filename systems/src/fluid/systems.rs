@@ -62,7 +62,7 @@ pub fn sample_fluid(
     mut q: Query<(&Position, &mut FluidSample)>,
 ) {
     let t = clock.time();
-    q.par_iter_mut().for_each(|(x, mut s)| {
+    crate::par_for_each_mut!(q, |(x, mut s)| {
         *s = cfg.flow.sample(x.0, t);
     });
 }
@@ -75,7 +75,7 @@ pub fn compute_body_forces(
     let g = cfg.gravity;
     let (on_g, on_b) = (cfg.terms.gravity, cfg.terms.buoyancy);
     let rho_f = cfg.liquid.density;
-    q.par_iter_mut().for_each(|(b, mut fg, mut fb)| {
+    crate::par_for_each_mut!(q, |(b, mut fg, mut fb)| {
         if on_g {
             fg.0 = DVec3::new(0.0, 0.0, -b.mass * g);
         }
@@ -91,7 +91,7 @@ pub fn compute_magnetic_buoyancy(
     mut q: Query<(&Position, &InertialBody, &mut MagneticBuoyancyForce)>,
 ) {
     let chi = cfg.liquid.susceptibility;
-    q.par_iter_mut().for_each(|(x, b, mut f)| {
+    crate::par_for_each_mut!(q, |(x, b, mut f)| {
         let fz = cfg
             .magnet
             .magnetic_buoyancy(chi, b.volume, cfg.magnet_y(x.0.z));
@@ -124,7 +124,7 @@ pub fn compute_undisturbed_flow(
     let rho = cfg.liquid.density;
     let factor = f64::from(u8::from(cfg.terms.undisturbed_flow))
         + 0.5 * f64::from(u8::from(cfg.terms.added_mass));
-    q.par_iter_mut().for_each(|(s, b, mut f)| {
+    crate::par_for_each_mut!(q, |(s, b, mut f)| {
         f.0 = factor * rho * b.volume * s.acceleration;
     });
 }
@@ -151,22 +151,22 @@ pub fn compute_history(
     let t_next = t_n + plan.dt();
     let implicit = cfg.integrator == Integrator::Implicit;
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
-    q.par_iter_mut()
-        .for_each(|(v, s, b, mut h, mut reset, mut f)| {
-            let slip = s.velocity - v.0;
-            if let Some((t_c, jump)) = reset.0.take() {
-                h.0.reset_at_collision(plan, t_c, jump, slip, t_n);
-            } else if h.0.time(plan) < t_n - 0.5 * plan.dt() {
-                h.0.push(plan, slip);
-            }
-            let c_h = basset_coefficient(b.diameter, rho, mu);
-            let integral = if implicit {
-                h.0.past_integral(plan, t_next)
-            } else {
-                h.0.current_integral(plan, t_n)
-            };
-            f.0 = c_h * integral;
-        });
+    // a history window costs ~1 µs per particle: parallel from a few dozen particles on
+    crate::par_for_each_mut!(q, 32, |(v, s, b, mut h, mut reset, mut f)| {
+        let slip = s.velocity - v.0;
+        if let Some((t_c, jump)) = reset.0.take() {
+            h.0.reset_at_collision(plan, t_c, jump, slip, t_n);
+        } else if h.0.time(plan) < t_n - 0.5 * plan.dt() {
+            h.0.push(plan, slip);
+        }
+        let c_h = basset_coefficient(b.diameter, rho, mu);
+        let integral = if implicit {
+            h.0.past_integral(plan, t_next)
+        } else {
+            h.0.current_integral(plan, t_n)
+        };
+        f.0 = c_h * integral;
+    });
 }
 
 /// Rotational drag of spheres with its stiffness (`Forces::Fluid`).
@@ -183,7 +183,7 @@ pub fn compute_rotational_drag(
     >,
 ) {
     let (rho, mu) = (cfg.liquid.density, cfg.liquid.viscosity);
-    q.par_iter_mut().for_each(|(w, s, b, mut t)| {
+    crate::par_for_each_mut!(q, |(w, s, b, mut t)| {
         let (torque, k, _) = rotational_drag(rho, mu, b.diameter, 0.5 * s.vorticity - w.0);
         t.torque = torque;
         t.stiffness = k;
@@ -274,13 +274,12 @@ pub fn integrate_positions(
     )>,
 ) {
     let dt = cfg.dt;
-    q.par_iter_mut()
-        .for_each(|(v, w, mut x, mut o, mut s, mut so)| {
-            s.0 = x.0;
-            so.0 = o.0;
-            x.0 += dt * v.0;
-            o.0 = rotate(o.0, w.0, dt);
-        });
+    crate::par_for_each_mut!(q, |(v, w, mut x, mut o, mut s, mut so)| {
+        s.0 = x.0;
+        so.0 = o.0;
+        x.0 += dt * v.0;
+        o.0 = rotate(o.0, w.0, dt);
+    });
 }
 
 /// Wrap positions into the periodic cell (`Finalize::WriteBack`).
@@ -288,7 +287,7 @@ pub fn wrap_periodic(domain: Res<FluidDomain>, mut q: Query<&mut Position>) {
     if domain.0.periodic.iter().all(Option::is_none) {
         return;
     }
-    q.par_iter_mut().for_each(|mut x| {
+    crate::par_for_each_mut!(q, |mut x| {
         x.0 = domain.0.wrap(x.0);
     });
 }
@@ -301,7 +300,7 @@ pub fn track_levitation(
 ) {
     let t_end = clock.time() + cfg.dt;
     let tol = cfg.levitation_tolerance;
-    q.par_iter_mut().for_each(|(x, mut l)| {
+    crate::par_for_each_mut!(q, |(x, mut l)| {
         let gap = (x.0.z - l.equilibrium_height).abs();
         if gap.is_nan() || gap > tol {
             l.last_outside = t_end;

@@ -141,7 +141,7 @@ pub fn compute_kernel_forces(
     )>,
 ) {
     let time = clock.map(|c| c.time()).unwrap_or(0.0);
-    q.par_iter_mut().for_each(|(id, x, o, shape, mut k)| {
+    crate::par_for_each_mut!(q, |(id, x, o, shape, mut k)| {
         let p = ParticleState {
             id: id.0,
             position: x.0,

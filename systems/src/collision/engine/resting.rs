@@ -59,6 +59,7 @@ impl Contact {
 
 impl Sim<'_, '_> {
     /// `I_i⁻¹ x` [1/(kg m²) · x].
+    #[inline]
     fn inv_inertia_times(&self, i: usize, x: DVec3) -> DVec3 {
         match self.p.inv_inertias {
             InverseInertia::Scalar(s) => x * s[i],
@@ -68,6 +69,7 @@ impl Sim<'_, '_> {
     }
 
     /// `t·K t` of contact `c` (see [`crate::collision::impulse::collision_matrix`]) [1/kg].
+    #[inline]
     fn k_quad(&self, c: &Contact, t: DVec3) -> f64 {
         let (i, j) = c.ij();
         let ra = c.r_a.cross(t);
@@ -79,6 +81,7 @@ impl Sim<'_, '_> {
         k
     }
 
+    #[inline]
     fn contact_velocity(&self, c: &Contact) -> DVec3 {
         let (i, j) = c.ij();
         let a = self.p.velocities[i] + self.p.angular_velocities[i].cross(c.r_a);
@@ -91,6 +94,7 @@ impl Sim<'_, '_> {
     }
 
     /// Applies the impulse `p` on `j` and `−p` on `i`.
+    #[inline]
     fn push(&mut self, c: &Contact, p: DVec3) {
         let (i, j) = c.ij();
         let dw = self.inv_inertia_times(i, c.r_a.cross(p));
@@ -244,6 +248,7 @@ impl Sim<'_, '_> {
 
     /// One projected Gauss–Seidel update of contact `c` (normal, then friction); returns the
     /// largest contact-velocity change it caused [m/s].
+    #[inline]
     fn relax(&mut self, c: &mut Contact, mu: f64) -> f64 {
         let nrm = c.normal;
         let vn = self.contact_velocity(c).dot(nrm);

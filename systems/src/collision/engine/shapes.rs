@@ -30,6 +30,7 @@ pub(super) fn rotated(q: DQuat, omega: DVec3, dt: f64) -> DQuat {
 
 impl Sim<'_, '_> {
     /// Whether particle `i` is a sphere (analytic path).
+    #[inline]
     pub(super) fn is_round(&self, i: usize) -> bool {
         self.p
             .spheroids
@@ -77,6 +78,7 @@ impl Sim<'_, '_> {
     }
 
     /// World inverse inertia of particle `i` at its current orientation.
+    #[inline]
     pub(super) fn inv_inertia(&self, i: usize) -> DMat3 {
         match self.p.inv_inertias {
             InverseInertia::Scalar(s) => DMat3::from_diagonal(DVec3::splat(s[i])),

@@ -1,0 +1,281 @@
+//! `magsep bench overhead` and `magsep bench recording`: what the framework and the recorder
+//! cost on top of the physics (timings, never assertions).
+//!
+//! * [`bench_overhead`]: wall time per step of a simple particle-fluid scene (N = 1, 10, 100,
+//!   1000 PVC spheres of 5 mm on a 10 mm grid in the levitation rig of
+//!   `scenes/levitation_single.toml`, history window 0.2 s, collisions on) through
+//!   [`Simulation::step`], with the executor the driver picks (`auto`) and with bevy's
+//!   multi-threaded executor for comparison. Rows `framework_step`: `particles`, `executor`,
+//!   `steps`, `us_per_step`, `us_per_particle_step` (best of 3 repetitions).
+//! * [`bench_recording`]: for each pipeline's representative shipped scene, the same steps with
+//!   and without the scene's own recording (`record.every`, written to a temporary file). Rows
+//!   `recording_overhead`: the wall times, the time spent writing frames (measured inside the
+//!   recorder, [`RecordTiming`]) and closing the file, and `overhead_fraction`: that time over
+//!   the time of the steps, extrapolated to the scene's full run (`frames_full_run` frames:
+//!   one every `every` steps plus the first and the last) where the pipeline knows its length
+//!   (else over the timed window): `frames_overhead_fraction` counts the frames only,
+//!   `overhead_fraction` also the one-off closing of the file (`finish_s`: summary, footer and
+//!   the `fsync`, which dominates runs of a few hundredths of a second).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use magsep_plugins::recorder::{RecordTiming, record_now};
+use serde_json::json;
+
+use crate::scene::{ExecutorChoice, RecordEvery, Registry, Scene, parse_scene};
+use crate::sim::Simulation;
+use crate::studies::bench::{BenchError, emit};
+
+/// `n` (at most 1000) spheres of `scenes/levitation_single.toml` on a 10 mm grid in its tank.
+pub fn sphere_grid_scene(n: usize) -> String {
+    let k = (1..=10).find(|k| k * k * k >= n).unwrap_or(10);
+    let points: Vec<String> = (0..n.min(1000))
+        .map(|i| {
+            let (a, b, c) = (i % k, (i / k) % k, i / (k * k));
+            format!(
+                "[{}, {}, {}]",
+                0.03 + 0.01 * a as f64,
+                0.03 + 0.01 * b as f64,
+                0.0075 + 0.01 * c as f64
+            )
+        })
+        .collect();
+    format!(
+        r#"
+[simulation]
+pipeline = "particle_fluid"
+seed = 1
+[particle_fluid]
+time_step = 1e-3
+duration = 1000.0
+history = {{ kind = "window", window = 0.2 }}
+observe_every = 10
+[liquid]
+density = 1403.0
+viscosity = 5.54e-3
+susceptibility = 7e-4
+[magnet]
+kind = "bottom"
+surface_field = 422e3
+pole_size = 0.1181
+half_height = 0.075
+[container]
+kind = "tank"
+edges = [0.15, 0.15, 0.15]
+[[particles]]
+count = {count}
+shape = {{ kind = "sphere", radius = 2.5e-3 }}
+density = 1434.0
+placement = {{ kind = "points", positions = [{points}] }}
+"#,
+        count = n.min(1000),
+        points = points.join(", ")
+    )
+}
+
+fn runtime(what: &str) -> impl Fn(String) -> BenchError + '_ {
+    move |e| BenchError::Runtime(format!("{what}: {e}"))
+}
+
+fn threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Best wall time per step over `reps` runs of `steps` steps (after 20 untimed steps).
+fn step_time(scene: &Scene, executor: ExecutorChoice, steps: u64) -> Result<f64, BenchError> {
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let mut sim = Simulation::builder(scene)
+            .executor(executor)
+            .build()
+            .map_err(|e| runtime("overhead scene")(e.to_string()))?;
+        for _ in 0..20 {
+            sim.step();
+        }
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            sim.step();
+        }
+        best = best.min(t0.elapsed().as_secs_f64() / steps as f64);
+    }
+    Ok(best)
+}
+
+/// `magsep bench overhead [--json] [--quick]`: rows `framework_step` (module docs).
+///
+/// # Errors
+/// [`BenchError`] when a scene cannot be built or a row not written.
+pub fn bench_overhead(as_json: bool, quick: bool) -> Result<(), BenchError> {
+    let mut rows = Vec::new();
+    let budget: u64 = if quick { 20_000 } else { 200_000 };
+    for n in [1usize, 10, 100, 1000] {
+        let scene = parse_scene(&sphere_grid_scene(n), &Registry::default())
+            .map_err(|e| runtime("overhead scene")(e.to_string()))?;
+        let steps = (budget / n as u64).clamp(200, 20_000);
+        for (name, executor) in [
+            ("auto", ExecutorChoice::Auto),
+            ("multi_threaded", ExecutorChoice::MultiThreaded),
+        ] {
+            let picked = if executor.multi_threaded(n) {
+                "multi_threaded"
+            } else {
+                "single_threaded"
+            };
+            let t = step_time(&scene, executor, steps)?;
+            emit(
+                &mut rows,
+                as_json,
+                json!({"name": "framework_step", "particles": n, "executor": name,
+                       "executor_used": picked, "threads": threads(), "steps": steps,
+                       "us_per_step": t * 1e6, "us_per_particle_step": t * 1e6 / n as f64,
+                       "steps_per_s": 1.0 / t}),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// The representative shipped scene of each pipeline and the steps timed (quick: fewer).
+const RECORDING_SCENES: &[(&str, &str, u64, u64)] = &[
+    (
+        "scenes/levitation_single.toml",
+        include_str!("../../scenes/levitation_single.toml"),
+        8000,
+        2000,
+    ),
+    (
+        "scenes/mds_case1a.toml",
+        include_str!("../../scenes/mds_case1a.toml"),
+        100,
+        0,
+    ),
+    (
+        "scenes/brownian_concentrated.toml",
+        include_str!("../../scenes/brownian_concentrated.toml"),
+        300,
+        100,
+    ),
+    (
+        "scenes/spheres_500.toml",
+        include_str!("../../scenes/spheres_500.toml"),
+        200,
+        100,
+    ),
+];
+
+/// One timed window: wall time of `steps` steps (with the first and last frame and closing the
+/// recording when `record` is set), and the recorder's own time.
+struct Window {
+    wall_s: f64,
+    steps: u64,
+    record_s: f64,
+    frames: u64,
+    finish_s: f64,
+    bytes: u64,
+}
+
+fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window, BenchError> {
+    let mut b = Simulation::builder(scene);
+    if let Some(path) = record {
+        b = b.record(path.clone());
+    }
+    let mut sim = b
+        .build()
+        .map_err(|e| runtime("recording scene")(e.to_string()))?;
+    sim.app.world.insert_resource(RecordTiming::default());
+    let t0 = Instant::now();
+    record_now(&mut sim.app.world);
+    let mut done = 0;
+    while done < steps && !sim.is_finished() {
+        sim.step();
+        done += 1;
+    }
+    record_now(&mut sim.app.world);
+    let t1 = Instant::now();
+    let summary = sim.summary();
+    sim.finish_recording(&summary)
+        .map_err(|e| runtime("closing the recording")(e.to_string()))?;
+    let finish_s = t1.elapsed().as_secs_f64();
+    let timing = sim
+        .app
+        .world
+        .get_resource::<RecordTiming>()
+        .copied()
+        .unwrap_or_default();
+    let bytes = record
+        .and_then(|p| std::fs::metadata(p).ok())
+        .map_or(0, |m| m.len());
+    Ok(Window {
+        wall_s: t0.elapsed().as_secs_f64(),
+        steps: done,
+        record_s: timing.seconds,
+        frames: timing.frames,
+        finish_s: if record.is_some() { finish_s } else { 0.0 },
+        bytes,
+    })
+}
+
+/// `magsep bench recording [--json] [--quick]`: rows `recording_overhead` (module docs).
+///
+/// # Errors
+/// [`BenchError`] when a scene cannot be run or recorded.
+pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
+    let mut rows = Vec::new();
+    let registry = Registry::default();
+    let path = std::env::temp_dir().join(format!(
+        "magsep-bench-recording-{}.mcap",
+        std::process::id()
+    ));
+    for &(name, text, full, short) in RECORDING_SCENES {
+        let steps = if quick { short } else { full };
+        if steps == 0 {
+            continue;
+        }
+        let scene = parse_scene(text, &registry).map_err(|e| runtime(name)(e.to_string()))?;
+        let plain = window(&scene, steps, None)?;
+        let rec = window(&scene, steps, Some(&path))?;
+        let _ = std::fs::remove_file(&path);
+        let every = {
+            let sim = Simulation::builder(&scene)
+                .build()
+                .map_err(|e| runtime(name)(e.to_string()))?;
+            sim.app
+                .world
+                .get_resource::<RecordEvery>()
+                .map_or(100, |r| r.0)
+        };
+        let recording_s = rec.record_s + rec.finish_s;
+        let step_s = (rec.wall_s - recording_s).max(1e-12) / rec.steps.max(1) as f64;
+        let frame_s = rec.record_s / rec.frames.max(1) as f64;
+        let total = scene.pipeline.as_ref().and_then(|p| p.total_steps(&scene));
+        let window_fraction = recording_s / (rec.wall_s - recording_s).max(1e-12);
+        let window_frames = rec.record_s / (rec.wall_s - recording_s).max(1e-12);
+        let (frames_full, fraction_full, frames_fraction) = match total {
+            Some(t) if t > 0 => {
+                let frames = t / every.max(1) + 2;
+                let run = t as f64 * step_s;
+                let cost = frames as f64 * frame_s;
+                (frames, (cost + rec.finish_s) / run, cost / run)
+            }
+            _ => (rec.frames, window_fraction, window_frames),
+        };
+        emit(
+            &mut rows,
+            as_json,
+            json!({"name": "recording_overhead", "scene": name,
+                   "pipeline": scene.pipeline.as_ref().map(|p| p.name()),
+                   "threads": threads(), "every": every, "steps": rec.steps,
+                   "wall_plain_s": plain.wall_s, "wall_recorded_s": rec.wall_s,
+                   "wall_ratio": rec.wall_s / plain.wall_s.max(1e-12),
+                   "frames": rec.frames, "bytes": rec.bytes,
+                   "record_s_per_frame": frame_s, "finish_s": rec.finish_s,
+                   "step_s": step_s,
+                   "window_overhead_fraction": window_fraction,
+                   "full_run_steps": total, "frames_full_run": frames_full,
+                   "frames_overhead_fraction": frames_fraction,
+                   "overhead_fraction": fraction_full}),
+        )?;
+    }
+    Ok(())
+}
