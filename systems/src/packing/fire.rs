@@ -56,8 +56,8 @@ pub struct FireParams {
 pub const STABLE_CONTACTS: f64 = 10.0;
 
 impl FireParams {
-    /// The defaults with `dt_max` capped at the stability bound of the explicit step for the
-    /// lightest body of `state`: a body of mass m with z unit-stiffness contacts has
+    /// The defaults with `dt_max` capped at the (translational) stability bound of the explicit
+    /// step for the lightest body of `state`: a body of mass m with z unit-stiffness contacts has
     /// omega_max^2 <= 2 z / m (Gershgorin on the overlap Hessian), and the semi-implicit Euler
     /// step is stable for dt < 2 / omega_max = 2 sqrt(m / (2 z)). With z =
     /// [`STABLE_CONTACTS`] this is 0.32 for unit spheres (m = pi / 6): above it FIRE

@@ -6,8 +6,8 @@
 //! delta^2 / 2 and tracking the largest overlap.
 //!
 //! Why it exists: FIRE spends nearly all of a sphere packing's time here. `spheres_500`
-//! evaluates ~2200 listed pairs in each of ~8e5 FIRE iterations (~1.8e9 pair evaluations per
-//! run). The generic route (`PackingState::contact_warm` -> `body_contact` -> `pair_contact`)
+//! evaluates ~2200 listed pairs in each of ~1e5 FIRE iterations (~2.3e8 pair evaluations per
+//! run; ~8e5 iterations before FIRE's largest step was capped at the stability bound). The generic route (`PackingState::contact_warm` -> `body_contact` -> `pair_contact`)
 //! rotates both body axes, branches on the body kinds and fills a whole `PairContact` per
 //! pair, and the pairs used to be filtered out of the symmetric CSR list and collected into a
 //! fresh `Vec` on every evaluation. Here the pairs come from the list's flat pair slice
