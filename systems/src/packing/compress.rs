@@ -200,7 +200,7 @@ pub fn run_removal_with(
             super::fire::remove_overlaps_fire_with(
                 state,
                 list,
-                super::fire::FireParams::default(),
+                super::fire::FireParams::for_state(state),
                 p.tolerance,
                 iterations.max(1),
                 kernels,

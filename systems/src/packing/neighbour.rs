@@ -189,6 +189,9 @@ pub struct NeighbourList {
     warm: Vec<Option<WarmStart>>,
     /// Each unordered pair once, in [`Self::unique_entries`] order.
     pairs: Vec<PairEntry>,
+    /// Centres at the last build, scaled with every compression since / D (the reference of
+    /// [`Self::note_displacements`]).
+    reference: Vec<DVec3>,
 }
 
 impl NeighbourList {
@@ -228,9 +231,32 @@ impl NeighbourList {
         }
     }
 
+    /// Record the translations of all particles at once (instead of [`Self::note_move`] per
+    /// move, for bodies that do not turn): the displacement bound of particle i is the
+    /// distance of its centre `positions[i]` from its centre at the last build, scaled with
+    /// the compressions since (the affine part is counted by [`Self::note_compression`]).
+    /// One square root per call instead of one per particle, and the bound is the net
+    /// displacement, not the path length. Invalidates the list when `positions` does not
+    /// match the build.
+    pub fn note_displacements(&mut self, positions: &[DVec3]) {
+        if positions.len() != self.reference.len() {
+            self.valid = false;
+            return;
+        }
+        let mut max2: f64 = 0.0;
+        for (x, x0) in positions.iter().zip(&self.reference) {
+            max2 = max2.max((*x - *x0).length_squared());
+        }
+        let m = max2.sqrt();
+        if m > self.max_moved {
+            self.max_moved = m;
+        }
+    }
+
     /// Record an affine compression of all centres by factors `s` <= 1 per axis.
     pub fn note_compression(&mut self, s: DVec3) {
         self.compressed += (DVec3::ONE - s).abs().max_element() * self.centre_range;
+        self.reference.iter_mut().for_each(|x| *x *= s);
     }
 
     /// Whether the list must be rebuilt before use.
@@ -383,6 +409,8 @@ impl NeighbourList {
             }
         }
         self.moved = vec![0.0; n];
+        self.reference.clear();
+        self.reference.extend_from_slice(&state.positions);
         self.max_moved = 0.0;
         self.compressed = 0.0;
         self.valid = true;
@@ -492,6 +520,57 @@ mod tests {
         // every pair within the skin is listed (the list may hold a few more: it tests < skin
         // on the segment distance, the same criterion, so the sets are equal)
         assert_eq!(got, want, "{shape:?} n {n} phi {phi}");
+    }
+
+    #[test]
+    fn net_displacements_keep_the_list_complete_until_it_asks_for_a_rebuild() {
+        // random-walk the centres and compress; while the list claims to be valid, every
+        // pair closer than contact + 0.1 skin must be listed
+        use rand::RngExt;
+        let n = 60;
+        let bodies: Vec<Body> = (0..n)
+            .map(|_| Body::from_shape(&Shape::Sphere { radius: 0.5 }, 1.0))
+            .collect();
+        let v: f64 = bodies.iter().map(|b| b.volume).sum();
+        let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(5, i)).collect();
+        let mut state = random_insertion(
+            &bodies,
+            PackingState::periodic_cube((v / 0.3).cbrt()),
+            &mut rngs,
+        )
+        .unwrap();
+        let mut list = NeighbourList::new(0.3);
+        list.build(&mut state);
+        let mut rng = particle_stream(9, 0);
+        let (mut checked, mut rebuilds) = (0, 0);
+        for step in 0..400 {
+            if step % 50 == 0 {
+                let s = DVec3::splat(0.995);
+                state.scale(s);
+                list.note_compression(s);
+            }
+            for x in &mut state.positions {
+                let u = DVec3::new(rng.random(), rng.random(), rng.random());
+                *x += 0.03 * (u - DVec3::splat(0.5));
+            }
+            list.note_displacements(&state.positions);
+            if list.needs_rebuild() {
+                list.build(&mut state);
+                rebuilds += 1;
+                continue;
+            }
+            if step % 5 != 0 {
+                continue;
+            }
+            let want = brute(&state, 0.1);
+            let got = listed(&state, &list);
+            assert!(want.iter().all(|p| got.contains(p)), "step {step}");
+            checked += 1;
+        }
+        assert!(
+            checked > 20 && rebuilds > 2,
+            "{checked} checks, {rebuilds} rebuilds"
+        );
     }
 
     #[test]
