@@ -12,7 +12,7 @@
 //! thread count.
 //!
 //! **Pairs.** Every pair of exerting particles `i < j` in the list has a slot (numbered by `i`,
-//! then `j`): [`VerletList::owned`] gives the pairs a particle owns, [`VerletList::slot`] the
+//! then `j`): [`VerletList::owned`] gives the pairs a particle owns, [`VerletList::entries`] the
 //! slot of each list entry, so a pair force can be computed once per pair into its slot and
 //! gathered by both particles (Newton's third law) in each particle's fixed list order:
 //! half the pair arithmetic and still thread-count independent sums.
