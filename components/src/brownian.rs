@@ -217,8 +217,12 @@ impl BrownianConfig {
 /// Counters of the time stepper and the interactions (a resource).
 #[derive(Resource, Debug, Default, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BrownianStats {
-    /// Accepted sub-steps in all.
+    /// Accepted sub-steps in all (intervals of the tree, two sub-steps each).
     pub substeps: u64,
+    /// Sub-steps taken per particle, summed over particles (multirate stepping; the global
+    /// scheme's is `substeps` × free particles).
+    #[serde(default)]
+    pub particle_substeps: u64,
     /// Rejected trial sub-steps (bisected).
     pub rejections: u64,
     /// Deepest bisection reached.

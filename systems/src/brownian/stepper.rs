@@ -202,5 +202,7 @@ pub fn advance<D: Dynamics>(
     }
 }
 
+pub mod multirate;
+
 #[cfg(test)]
 mod tests;
