@@ -139,6 +139,37 @@ pub enum StepControl {
         /// Deepest bisection (sub-steps of dt / 2^depth). Default 24. Range 1..=40.
         max_depth: u32,
     },
+    /// As `Adaptive`, but only the particles that fail the test, with their interaction
+    /// partners, are bisected; the others take the whole interval and enter the refined
+    /// sub-steps at interpolated positions (multirate). Free draining with a soft or no core;
+    /// with hydrodynamic interactions or hard cores it steps as `Adaptive`.
+    Multirate {
+        /// As in `Adaptive`. Range (0, 1].
+        tolerance: f64,
+        /// As in `Adaptive`. Range (0, 10].
+        max_displacement: f64,
+        /// As in `Adaptive`. Range 1..=40.
+        max_depth: u32,
+    },
+}
+
+impl StepControl {
+    /// `(tolerance, max_displacement, max_depth)` of the adaptive kinds (None: fixed).
+    pub fn adaptive_parameters(&self) -> Option<(f64, f64, u32)> {
+        match *self {
+            Self::Fixed => None,
+            Self::Adaptive {
+                tolerance,
+                max_displacement,
+                max_depth,
+            }
+            | Self::Multirate {
+                tolerance,
+                max_displacement,
+                max_depth,
+            } => Some((tolerance, max_displacement, max_depth)),
+        }
+    }
 }
 
 impl Default for StepControl {

@@ -93,7 +93,7 @@ impl SimPlugin for BrownianIntegratorPlugin {
 pub fn brownian_force_use(control: &StepControl) -> ForceUse {
     let contributions = match control {
         StepControl::Fixed => Consumption::Consumed,
-        StepControl::Adaptive { .. } => Consumption::Refused(
+        StepControl::Adaptive { .. } | StepControl::Multirate { .. } => Consumption::Refused(
             "the brownian pipeline's adaptive stepper re-evaluates forces at every sub-step, \
              and a ForceContribution component is a value computed once per step (it would \
              be frozen over the sub-steps); implement `magsep_systems::forces::ExternalForce` \

@@ -182,8 +182,8 @@ pub fn bench_brownian_with(
     let edge = pipeline::box_edge(n, RADIUS, PIPELINE_VOLUME_FRACTION);
     let mut last_positions = Vec::new();
     // (a) the full pipeline, free draining, dipoles
-    for (control, adaptive) in [("fixed", false), ("adaptive", true)] {
-        let scene_text = free_draining_scene(n, adaptive, 1);
+    for control in ["fixed", "adaptive", "multirate"] {
+        let scene_text = free_draining_scene(n, control, 1);
         let scene = crate::scene::parse_scene(&scene_text, &Default::default())
             .map_err(|e| BenchError::Runtime(format!("bench scene: {e}")))?;
         for &threads in &sizes.threads {
@@ -207,6 +207,7 @@ pub fn bench_brownian_with(
                     "particle_steps_per_s": r.particle_steps_per_s,
                     "particle_steps_per_s_per_thread": r.particle_steps_per_s / threads as f64,
                     "substeps_per_step": r.substeps_per_step,
+                    "particle_substeps_per_step": r.particle_substeps_per_step,
                     "force_evaluations_per_step": r.force_evaluations_per_step,
                     "lammps_reference_per_core": LAMMPS_REFERENCE_PER_CORE,
                     "load_average_1min": load_average(),

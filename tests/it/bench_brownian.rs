@@ -40,17 +40,24 @@ fn bench_rows_are_well_formed_with_positive_rates() {
     let case =
         |c: &str| -> Vec<&serde_json::Value> { rows.iter().filter(|r| r["case"] == c).collect() };
     let pipe = case("free_draining_dipoles");
-    assert_eq!(pipe.len(), 4, "fixed and adaptive at 1 and 2 threads");
+    assert_eq!(
+        pipe.len(),
+        6,
+        "fixed, adaptive and multirate at 1 and 2 threads"
+    );
     for r in &pipe {
         positive(r, "particle_steps_per_s");
         positive(r, "particle_steps_per_s_per_thread");
         assert_eq!(r["n"], 200);
         assert!(r["steps"].as_u64().unwrap() >= 3);
         let sub = positive(r, "substeps_per_step");
+        let per_particle = positive(r, "particle_substeps_per_step");
         if r["step_control"] == "fixed" {
             assert_eq!(sub, 1.0);
+            assert_eq!(per_particle, 1.0);
         } else {
             assert!(sub >= 2.0);
+            assert!(per_particle >= 2.0 && per_particle <= sub, "{r}");
         }
     }
     let mirror = case("lammps_mirror");

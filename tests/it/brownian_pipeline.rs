@@ -112,6 +112,11 @@ fn dipole_pair_fixed_step_fails_at_thesis_dt_adaptive_does_not() {
         r#"{ kind = "adaptive", tolerance = 1e-2, max_displacement = 0.2, max_depth = 30 }"#;
     let (lo, hi) = separation_range(&pair_scene(5e-5, 100, adaptive));
     assert!(lo > 1.98 && hi < 2.4, "adaptive: {lo}..{hi} radii");
+    // and with multirate error control (only the pair is refined)
+    let multirate =
+        r#"{ kind = "multirate", tolerance = 1e-2, max_displacement = 0.2, max_depth = 30 }"#;
+    let (lo, hi) = separation_range(&pair_scene(5e-5, 100, multirate));
+    assert!(lo > 1.98 && hi < 2.4, "multirate: {lo}..{hi} radii");
     // where the fixed step becomes stable: D dt U''/kT = 0.71 at dt = 1e-7 s
     let (lo, hi) = separation_range(&pair_scene(1e-7, 300, fixed));
     assert!(lo > 1.98 && hi < 2.4, "fixed at 1e-7 s: {lo}..{hi} radii");
@@ -142,9 +147,15 @@ placement = {{ kind = "box", min = [0.0, 0.0, 0.0], max = [6e-6, 6e-6, 6e-6] }}
 
 #[test]
 fn bitwise_identical_for_one_and_two_threads() {
-    let s = scene(&dense_scene(
-        r#"{ kind = "adaptive", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }"#,
-    ));
+    for kind in ["adaptive", "multirate"] {
+        identical_for_one_and_two_threads(kind);
+    }
+}
+
+fn identical_for_one_and_two_threads(kind: &str) {
+    let s = scene(&dense_scene(&format!(
+        r#"{{ kind = "{kind}", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }}"#
+    )));
     let run = |threads: usize, single: bool| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -177,11 +177,8 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
             format!("must be in (0, 0.1], got {t}"),
         ));
     }
-    if let Some(StepControl::Adaptive {
-        tolerance,
-        max_displacement,
-        max_depth,
-    }) = b.step_control
+    if let Some((tolerance, max_displacement, max_depth)) =
+        b.step_control.and_then(|c| c.adaptive_parameters())
     {
         let p = "brownian.step_control";
         if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 1.0) {

@@ -189,6 +189,7 @@ pub fn summary_of(
     for r in results {
         let s = &r.stats;
         stats.substeps += s.substeps;
+        stats.particle_substeps += s.particle_substeps;
         stats.rejections += s.rejections;
         stats.max_depth_reached = stats.max_depth_reached.max(s.max_depth_reached);
         stats.depth_limit_hits += s.depth_limit_hits;
@@ -232,6 +233,8 @@ pub fn summary_of(
         "step_control": config.step_control,
         "stepper": {
             "substeps_per_step": stats.substeps as f64 / total_steps as f64,
+            "particle_substeps_per_step":
+                stats.particle_substeps as f64 / (total_steps * (n as u64).max(1)) as f64,
             "rejections": stats.rejections,
             "force_evaluations": stats.force_evaluations,
             "max_depth_reached": stats.max_depth_reached,

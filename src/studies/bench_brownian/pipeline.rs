@@ -25,14 +25,16 @@ pub fn box_edge(n: usize, radius: f64, phi: f64) -> f64 {
 
 /// Scene text: `n` spheres (R = 75 nm, saturated moment 0.87e-16 A m²) uniform in a cube
 /// centred on the origin at volume fraction 1e-3, B = 1 T along x, no fibres, free draining,
-/// Mie contact (default), dipole cut-off 30 radii, dt = 1e-6 s; `fixed` or the adaptive
-/// default step control.
-pub fn free_draining_scene(n: usize, adaptive: bool, seed: u64) -> String {
+/// Mie contact (default), dipole cut-off 30 radii, dt = 1e-6 s; step control `control`:
+/// `fixed`, `adaptive` (the default) or `multirate`.
+pub fn free_draining_scene(n: usize, control: &str, seed: u64) -> String {
     let h = 0.5 * box_edge(n, RADIUS, PIPELINE_VOLUME_FRACTION);
-    let control = if adaptive {
-        ""
-    } else {
-        "step_control = { kind = \"fixed\" }\n"
+    let control = match control {
+        "adaptive" => "",
+        "multirate" => {
+            "step_control = { kind = \"multirate\", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }\n"
+        }
+        _ => "step_control = { kind = \"fixed\" }\n",
     };
     format!(
         "[simulation]\n\
@@ -69,6 +71,8 @@ pub struct PipelineRate {
     pub particle_steps_per_s: f64,
     /// Accepted sub-steps per step (1 fixed; 2 or more adaptive).
     pub substeps_per_step: f64,
+    /// Sub-steps per particle and step (the multirate stepper's cost measure).
+    pub particle_substeps_per_step: f64,
     /// Force evaluations inside the stepper per step (besides the ECS force systems).
     pub force_evaluations_per_step: f64,
 }
@@ -127,6 +131,8 @@ pub fn pipeline_rate(
             seconds: el,
             particle_steps_per_s: (n as u64 * steps) as f64 / el,
             substeps_per_step: per(s1.substeps, s0.substeps),
+            particle_substeps_per_step: per(s1.particle_substeps, s0.particle_substeps)
+                / n.max(1) as f64,
             force_evaluations_per_step: per(s1.force_evaluations, s0.force_evaluations),
         };
         let x = sim
@@ -145,7 +151,7 @@ pub fn pipeline_rate(
 /// [`BenchError::Runtime`] when the scene cannot be built.
 pub fn initial_positions(n: usize, seed: u64) -> Result<Vec<DVec3>, BenchError> {
     let scene =
-        crate::scene::parse_scene(&free_draining_scene(n, false, seed), &Default::default())
+        crate::scene::parse_scene(&free_draining_scene(n, "fixed", seed), &Default::default())
             .map_err(|e| BenchError::Runtime(format!("bench scene: {e}")))?;
     let sim = Simulation::from_scene(&scene, RunOptions::default())
         .map_err(|e| BenchError::Runtime(format!("bench simulation: {e}")))?;

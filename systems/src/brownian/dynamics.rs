@@ -13,6 +13,7 @@ use super::contact::{remove_overlaps, swept_capture};
 use super::hydro::Mobility;
 use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
 use super::stepper::Dynamics;
+use super::stepper::multirate::LocalDynamics;
 
 /// Hydrodynamic interactions among the free particles: the prepared mobility and the particle
 /// index of each of its rows.
@@ -59,6 +60,9 @@ pub struct PipelineDynamics<'a> {
     pub hydro: Option<&'a HydroState>,
     /// Neighbour lists of the pair forces (cached across evaluations).
     pub lists: &'a mut PairLists,
+    /// Moments at the step start [A m²] (held for the particles a multirate sub-step does
+    /// not move).
+    pub start_moments: &'a [DVec3],
     /// Neighbour-list rebuilds in this step.
     pub list_builds: u64,
     /// Hard cores.
@@ -222,6 +226,84 @@ impl Dynamics for PipelineDynamics<'_> {
                     },
                 ));
             }
+        }
+    }
+}
+
+impl LocalDynamics for PipelineDynamics<'_> {
+    /// The forces on the `active` particles only, with the moments of the others held at their
+    /// step-start values; free-draining mobility (the multirate stepper is not used with
+    /// hydrodynamic interactions).
+    fn drift_of(&mut self, x: &[DVec3], active: &[usize], v: &mut [DVec3]) {
+        let exerts = self.exerts();
+        let view = ParticleView {
+            radii: self.radii,
+            moments: self.laws,
+            mobile: &self.mobile,
+            exerts: &exerts,
+        };
+        self.list_builds += self.model.update_lists(x, &view, self.lists);
+        let mut moments = self.start_moments.to_vec();
+        moments.resize(x.len(), DVec3::ZERO);
+        let mut f: Vec<DVec3> = active
+            .iter()
+            .map(|&i| {
+                let (m, field) = self.model.moment_and_field_force(x, &view, i);
+                moments[i] = m;
+                field + self.extra[i]
+            })
+            .collect();
+        let (dr, cr) = (
+            self.model.dipole_range(&view),
+            self.model.contact_range(&view),
+        );
+        for (fi, &i) in f.iter_mut().zip(active) {
+            *fi += self
+                .model
+                .dipole_force_on(x, &moments, &view, self.lists, dr, i)
+                + self.model.contact_force_on(x, &view, self.lists, cr, i);
+        }
+        if let Some(k) = self.kernels {
+            let t = self.time.0 + self.fraction * self.time.1;
+            let mut wanted = vec![false; x.len()];
+            for &i in active {
+                wanted[i] = self.mobile[i];
+            }
+            let mut out = std::mem::take(&mut self.kernel_out);
+            out.resize(x.len(), (DVec3::ZERO, DVec3::ZERO));
+            let (ids, shapes) = (self.ids, self.shapes);
+            k.evaluate_dense(
+                |i| {
+                    wanted[i].then(|| ParticleState {
+                        id: ids[i],
+                        position: x[i],
+                        orientation: glam::DQuat::IDENTITY,
+                        shape: shapes[i],
+                        time: t,
+                    })
+                },
+                &mut out,
+            );
+            for (fi, &i) in f.iter_mut().zip(active) {
+                *fi += out[i].0;
+            }
+            self.kernel_out = out;
+        }
+        for (fi, &i) in f.iter().zip(active) {
+            v[i] = if self.mobile[i] {
+                *fi / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
+            } else {
+                DVec3::ZERO
+            };
+        }
+    }
+
+    fn partners(&mut self, _x: &[DVec3], i: usize, f: &mut dyn FnMut(usize)) {
+        for (j, _) in self.lists.dipole.entries(i) {
+            f(j);
+        }
+        for (j, _) in self.lists.contact.entries(i) {
+            f(j);
         }
     }
 }

@@ -149,6 +149,32 @@ impl ForceModel {
         total_field_gradient(&self.sources, self.b_ext, p, self.tolerance)
     }
 
+    /// Moment [A m²] and field force \[N\] of particle `i` (the force only when it is mobile).
+    pub fn moment_and_field_force(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        i: usize,
+    ) -> (DVec3, DVec3) {
+        let law = &view.moments[i];
+        if !law.is_magnetic() {
+            (DVec3::ZERO, DVec3::ZERO)
+        } else if view.mobile[i] && !self.sources.is_empty() {
+            let g = self.field_gradient(x[i]);
+            (
+                self.moment(law, g.b),
+                crate::field::dipole_force(&g, law, self.kt),
+            )
+        } else {
+            let b = if self.sources.is_empty() {
+                self.b_ext
+            } else {
+                total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
+            };
+            (self.moment(law, b), DVec3::ZERO)
+        }
+    }
+
     /// Moments of every particle and field forces on the mobile ones, from one field
     /// evaluation per particle (with the gradient only where a force is needed).
     pub fn moments_and_field(
@@ -160,23 +186,7 @@ impl ForceModel {
     ) {
         let mut pairs = vec![(DVec3::ZERO, DVec3::ZERO); x.len()];
         par_fill(&mut pairs, |i, o| {
-            let law = &view.moments[i];
-            if !law.is_magnetic() {
-                *o = (DVec3::ZERO, DVec3::ZERO);
-            } else if view.mobile[i] && !self.sources.is_empty() {
-                let g = self.field_gradient(x[i]);
-                *o = (
-                    self.moment(law, g.b),
-                    crate::field::dipole_force(&g, law, self.kt),
-                );
-            } else {
-                let b = if self.sources.is_empty() {
-                    self.b_ext
-                } else {
-                    total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
-                };
-                *o = (self.moment(law, b), DVec3::ZERO);
-            }
+            *o = self.moment_and_field_force(x, view, i)
         });
         for (i, (m, f)) in pairs.into_iter().enumerate() {
             moments[i] = m;
@@ -284,27 +294,48 @@ impl ForceModel {
         lists: &PairLists,
         out: &mut [DVec3],
     ) {
-        let Some(cut) = self.dipole_cutoff else {
+        if self.dipole_cutoff.is_none() {
             out.fill(DVec3::ZERO);
             return;
-        };
-        let amax = view.radii.iter().copied().fold(0.0, f64::max);
-        let (list, range) = (&lists.dipole, cut * amax);
+        }
+        let range = self.dipole_range(view);
         par_fill(out, |i, f| {
-            *f = DVec3::ZERO;
-            if !view.mobile[i] || moments[i] == DVec3::ZERO {
-                return;
-            }
-            let (ai, mi) = (view.radii[i], moments[i]);
-            let mut sum = DVec3::ZERO;
-            list.for_each_neighbour(x, i, range, |j, d| {
-                let rc = cut * 0.5 * (ai + view.radii[j]);
-                if d.length_squared() < rc * rc {
-                    sum += dipole_force(d, mi, moments[j]);
-                }
-            });
-            *f = sum;
+            *f = self.dipole_force_on(x, moments, view, lists, range, i)
         });
+    }
+
+    /// Dipole cut-off of the largest pair \[m\] (0 without dipole forces).
+    pub fn dipole_range(&self, view: &ParticleView) -> f64 {
+        self.dipole_cutoff
+            .map_or(0.0, |c| c * view.radii.iter().copied().fold(0.0, f64::max))
+    }
+
+    /// Dipole-dipole force on particle `i` \[N\] from its listed neighbours within `range`
+    /// ([`ForceModel::dipole_range`]; zero unless `i` is mobile and magnetic).
+    pub fn dipole_force_on(
+        &self,
+        x: &[DVec3],
+        moments: &[DVec3],
+        view: &ParticleView,
+        lists: &PairLists,
+        range: f64,
+        i: usize,
+    ) -> DVec3 {
+        let Some(cut) = self.dipole_cutoff else {
+            return DVec3::ZERO;
+        };
+        if !view.mobile[i] || moments[i] == DVec3::ZERO {
+            return DVec3::ZERO;
+        }
+        let (ai, mi) = (view.radii[i], moments[i]);
+        let mut sum = DVec3::ZERO;
+        lists.dipole.for_each_neighbour(x, i, range, |j, d| {
+            let rc = cut * 0.5 * (ai + view.radii[j]);
+            if d.length_squared() < rc * rc {
+                sum += dipole_force(d, mi, moments[j]);
+            }
+        });
+        sum
     }
 
     /// Mie contact forces on the mobile particles from the exerting ones \[N\].
@@ -319,20 +350,41 @@ impl ForceModel {
             out.fill(DVec3::ZERO);
             return;
         };
-        let amax = view.radii.iter().copied().fold(0.0, f64::max);
-        let (list, range) = (&lists.contact, 2.0 * amax * mie.min_ratio);
+        let range = 2.0 * view.radii.iter().copied().fold(0.0, f64::max) * mie.min_ratio;
         par_fill(out, |i, f| {
-            *f = DVec3::ZERO;
-            if !view.mobile[i] {
-                return;
-            }
-            let ai = view.radii[i];
-            let mut sum = DVec3::ZERO;
-            list.for_each_neighbour(x, i, range, |j, d| {
-                sum += mie.force(d, ai + view.radii[j]);
-            });
-            *f = sum;
+            *f = self.contact_force_on(x, view, lists, range, i)
         });
+    }
+
+    /// Mie contact force on particle `i` \[N\] from its listed neighbours within `range` \[m\]
+    /// (zero unless it is mobile).
+    pub fn contact_force_on(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        lists: &PairLists,
+        range: f64,
+        i: usize,
+    ) -> DVec3 {
+        let Some(mie) = self.mie else {
+            return DVec3::ZERO;
+        };
+        if !view.mobile[i] {
+            return DVec3::ZERO;
+        }
+        let ai = view.radii[i];
+        let mut sum = DVec3::ZERO;
+        lists.contact.for_each_neighbour(x, i, range, |j, d| {
+            sum += mie.force(d, ai + view.radii[j]);
+        });
+        sum
+    }
+
+    /// Mie range of the largest pair \[m\] (0 without a soft core).
+    pub fn contact_range(&self, view: &ParticleView) -> f64 {
+        self.mie.map_or(0.0, |m| {
+            2.0 * view.radii.iter().copied().fold(0.0, f64::max) * m.min_ratio
+        })
     }
 
     /// All parts at configuration `x` (the sub-step evaluation of the integrator), with the

@@ -108,12 +108,7 @@ pub fn advance<D: Dynamics>(
     });
     let w = wiener_increments(dynamics.mobile(), dt, rngs);
     let mut b = vec![DVec3::ZERO; n];
-    let StepControl::Adaptive {
-        tolerance,
-        max_displacement,
-        max_depth,
-    } = *control
-    else {
+    let Some((tolerance, max_displacement, max_depth)) = control.adaptive_parameters() else {
         dynamics.noise(&w, &mut b);
         let from = x.clone();
         for i in 0..n {
@@ -122,6 +117,7 @@ pub fn advance<D: Dynamics>(
         dynamics.constrain(&from, x);
         dynamics.accept(&from, x, 1.0);
         stats.substeps += 1;
+        stats.particle_substeps += dynamics.mobile().iter().filter(|&&m| m).count() as u64;
         return;
     };
     let mut bl = vec![DVec3::ZERO; n];
@@ -176,6 +172,7 @@ pub fn advance<D: Dynamics>(
             }
             stats.max_depth_reached = stats.max_depth_reached.max(depth + 1);
             stats.substeps += 2;
+            stats.particle_substeps += 2 * mobile.iter().filter(|&&m| m).count() as u64;
             // the two half steps are accepted one after the other (capture on each)
             let from = x.clone();
             let mut xm = xm;

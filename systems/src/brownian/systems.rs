@@ -23,6 +23,7 @@ use super::hydro::{Mobility, MobilityMethod, auto_method};
 use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
 use super::stepper::advance;
+use super::stepper::multirate::advance_multirate;
 use crate::field::CylinderSource;
 use crate::forces::ExternalForces;
 use magsep_components::forces::KernelForce;
@@ -404,6 +405,7 @@ pub fn integrate_brownian(
         kt: config.kt(),
         hydro: ws.hydro.as_ref(),
         lists: &mut ws.lists,
+        start_moments: &ws.moments,
         list_builds: 0,
         hard_core: config.contact == ContactModel::HardCore,
         step: clock.step,
@@ -415,15 +417,31 @@ pub fn integrate_brownian(
     let mut v0 = vec![DVec3::ZERO; n];
     dynamics.velocities(&net, &mut v0);
     let mut x = std::mem::take(&mut ws.positions);
-    advance(
-        &mut dynamics,
-        &mut x,
-        Some(v0),
-        clock.dt,
-        &config.step_control,
-        &mut ws.rngs,
-        &mut stats,
-    );
+    match config.step_control {
+        // multirate needs per-particle noise and drift: free draining, no hard cores
+        StepControl::Multirate {
+            tolerance,
+            max_displacement,
+            max_depth,
+        } if dynamics.hydro.is_none() && !dynamics.hard_core => advance_multirate(
+            &mut dynamics,
+            &mut x,
+            Some(v0),
+            clock.dt,
+            (tolerance, max_displacement, max_depth),
+            &mut ws.rngs,
+            &mut stats,
+        ),
+        _ => advance(
+            &mut dynamics,
+            &mut x,
+            Some(v0),
+            clock.dt,
+            &config.step_control,
+            &mut ws.rngs,
+            &mut stats,
+        ),
+    }
     let captures = std::mem::take(&mut dynamics.captures);
     stats.hard_core_sweeps += dynamics.sweeps;
     stats.neighbour_list_builds += dynamics.list_builds;

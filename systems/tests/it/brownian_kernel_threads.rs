@@ -70,6 +70,7 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
                 kt,
                 hydro: None,
                 lists: &mut lists,
+                start_moments: &[],
                 list_builds: 0,
                 hard_core: false,
                 step,

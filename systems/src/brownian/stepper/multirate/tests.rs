@@ -40,8 +40,8 @@ impl Dynamics for Springs {
         &self.mobile
     }
     fn drift(&mut self, x: &[DVec3], v: &mut [DVec3]) {
-        for i in 0..x.len() {
-            v[i] = self.force(x, i);
+        for (i, vi) in v.iter_mut().enumerate().take(x.len()) {
+            *vi = self.force(x, i);
         }
     }
     fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]) {
@@ -88,7 +88,6 @@ fn run(
     multirate: bool,
     tol: f64,
 ) -> (Vec<DVec3>, BrownianStats) {
-    let n = ids.len();
     let mut x: Vec<DVec3> = ids.iter().map(|&i| DVec3::X * (i as f64) * 0.1).collect();
     let mut rngs: Vec<_> = ids.iter().map(|&i| particle_stream(4, i)).collect();
     let mut stats = BrownianStats::default();
