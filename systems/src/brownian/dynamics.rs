@@ -80,6 +80,30 @@ pub struct PipelineDynamics<'a> {
 }
 
 impl PipelineDynamics<'_> {
+    /// The external force kernels' (force \[N\], torque [N m]) on the particles with
+    /// `wanted[i]`, at the time of the next drift (zero for the others; empty without kernels).
+    fn kernel_forces(&mut self, x: &[DVec3], wanted: &[bool]) -> &[(DVec3, DVec3)] {
+        let Some(k) = self.kernels else {
+            return &[];
+        };
+        let t = self.time.0 + self.fraction * self.time.1;
+        self.kernel_out.resize(x.len(), (DVec3::ZERO, DVec3::ZERO));
+        let (ids, shapes) = (self.ids, self.shapes);
+        k.evaluate_dense(
+            |i| {
+                wanted[i].then(|| ParticleState {
+                    id: ids[i],
+                    position: x[i],
+                    orientation: glam::DQuat::IDENTITY,
+                    shape: shapes[i],
+                    time: t,
+                })
+            },
+            &mut self.kernel_out,
+        );
+        &self.kernel_out
+    }
+
     fn exerts(&self) -> Vec<bool> {
         self.mobile
             .iter()
@@ -139,27 +163,12 @@ impl Dynamics for PipelineDynamics<'_> {
             .map(|i| parts.total(i) + self.extra[i])
             .collect();
         self.parts = parts;
-        if let Some(k) = self.kernels {
-            let t = self.time.0 + self.fraction * self.time.1;
-            let mut out = std::mem::take(&mut self.kernel_out);
-            out.resize(x.len(), (DVec3::ZERO, DVec3::ZERO));
-            let (mobile, ids, shapes) = (&self.mobile, self.ids, self.shapes);
-            k.evaluate_dense(
-                |i| {
-                    mobile[i].then(|| ParticleState {
-                        id: ids[i],
-                        position: x[i],
-                        orientation: glam::DQuat::IDENTITY,
-                        shape: shapes[i],
-                        time: t,
-                    })
-                },
-                &mut out,
-            );
-            for (fi, (fk, _)) in f.iter_mut().zip(&out) {
+        if self.kernels.is_some() {
+            let mobile = self.mobile.clone();
+            let out = self.kernel_forces(x, &mobile);
+            for (fi, (fk, _)) in f.iter_mut().zip(out) {
                 *fi += *fk;
             }
-            self.kernel_out = out;
         }
         self.velocities(&f, v);
     }
@@ -263,31 +272,15 @@ impl LocalDynamics for PipelineDynamics<'_> {
                 .dipole_force_on(x, &moments, &view, self.lists, dr, i)
                 + self.model.contact_force_on(x, &view, self.lists, cr, i);
         }
-        if let Some(k) = self.kernels {
-            let t = self.time.0 + self.fraction * self.time.1;
+        if self.kernels.is_some() {
             let mut wanted = vec![false; x.len()];
             for &i in active {
                 wanted[i] = self.mobile[i];
             }
-            let mut out = std::mem::take(&mut self.kernel_out);
-            out.resize(x.len(), (DVec3::ZERO, DVec3::ZERO));
-            let (ids, shapes) = (self.ids, self.shapes);
-            k.evaluate_dense(
-                |i| {
-                    wanted[i].then(|| ParticleState {
-                        id: ids[i],
-                        position: x[i],
-                        orientation: glam::DQuat::IDENTITY,
-                        shape: shapes[i],
-                        time: t,
-                    })
-                },
-                &mut out,
-            );
+            let out = self.kernel_forces(x, &wanted);
             for (fi, &i) in f.iter_mut().zip(active) {
                 *fi += out[i].0;
             }
-            self.kernel_out = out;
         }
         for (fi, &i) in f.iter().zip(active) {
             v[i] = if self.mobile[i] {

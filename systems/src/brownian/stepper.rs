@@ -17,8 +17,10 @@
 //! moves a particle by more than `max_displacement · a_i` (no tunnelling through a neighbour or
 //! a fibre); otherwise both halves are tried again recursively, to `max_depth`. Because the
 //! bridge refines the *same* Brownian path, the result converges to the path's solution as
-//! the tolerance shrinks, the statistics of the noise are exact at every depth, and a fixed
-//! and an adaptive run of one seed see the same Wiener increments per `dt`.
+//! the tolerance shrinks and the statistics of the noise are exact at every depth. The bridge
+//! draws come from each particle's own stream, so a fixed and an adaptive run of one seed share
+//! the Wiener increments of the first step only (later increments follow the draws of the
+//! refinements).
 //!
 //! The mobility's square root `B` is frozen over one `dt` (it is built once per step from the
 //! start configuration); the drift `μ F(x)` is re-evaluated at every sub-step (with the

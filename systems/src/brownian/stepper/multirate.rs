@@ -20,6 +20,9 @@
 //! (local time stepping with a buffer layer and interpolated neighbours) are first order in the
 //! coupling between fast and slow particles, like the explicit update itself.
 //!
+//! The bridge draws come from each particle's own stream in the order of its own refinements,
+//! so a multirate and a global run of one seed share the first step's increments only.
+//!
 //! Not for hydrodynamic interactions (the noise couples all particles) or hard cores (the
 //! overlap projection is global): the caller falls back to [`super::advance`].
 
