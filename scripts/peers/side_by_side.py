@@ -8,10 +8,10 @@ peer's JSON line of the same round, and one ratio line is printed per match:
     {"workload": ..., "round": k, "peer": "lammps", "peer_value": ..., "magsep_value": ...,
      "ratio": magsep / peer, "metric": ..., "threads": ..., "date_utc": ..., "load_average_1min": ...}
 
-Usage (from the repository root; the anchor benchmarks are in $ANCHOR, default
-../shared/anchor-bench):
+Usage (from the repository root; $ANCHOR names the directory of the anchor benchmarks,
+described under [AnchorBench] in docs/references.md):
 
-    scripts/peers/side_by_side.py field brownian --rounds 2 > ratios.jsonl
+    ANCHOR=/path/to/anchor-bench scripts/peers/side_by_side.py field brownian --rounds 2 > ratios.jsonl
 
 Workloads:
     field     anchor `anchor-bench field --threads 1 --reps 5` (magba)  vs `magsep bench field --json`
@@ -30,7 +30,7 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-ANCHOR = os.environ.get("ANCHOR", os.path.join(ROOT, "..", "shared", "anchor-bench"))
+ANCHOR = os.environ.get("ANCHOR", "")
 ANCHOR_TARGET = os.environ.get("ANCHOR_TARGET", "/tmp/anchor-target")
 MAGSEP = os.environ.get("MAGSEP", os.path.join(ROOT, "target", "release", "magsep"))
 
@@ -115,6 +115,9 @@ def main(argv):
         names.append(argv[i])
         i += 1
     names = names or list(WORKLOADS)
+    if not ANCHOR or not os.path.isdir(ANCHOR):
+        say("set ANCHOR to the directory of the anchor benchmarks (see docs/references.md)")
+        return 2
     if not os.path.exists(MAGSEP):
         subprocess.run(["cargo", "build", "--release"], cwd=ROOT, check=True)
     try:
