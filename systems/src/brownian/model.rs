@@ -112,6 +112,18 @@ pub struct ForceModel {
     pub dipole_cutoff: Option<f64>,
 }
 
+/// Dipole force on `i` \[N\] from `j` at `d = x_i − x_j` within the pair's cut-off `cut` × mean
+/// radius (zero beyond): the one pair rule of every dipole kernel.
+#[inline]
+fn dipole_pair(cut: f64, d: DVec3, (ai, aj): (f64, f64), mi: DVec3, mj: DVec3) -> DVec3 {
+    let rc = cut * 0.5 * (ai + aj);
+    if d.length_squared() < rc * rc {
+        dipole_force(d, mi, mj)
+    } else {
+        DVec3::ZERO
+    }
+}
+
 /// Particles per chunk of the pair-force pass.
 const PAIR_CHUNK: usize = 256;
 
@@ -199,17 +211,18 @@ impl ForceModel {
     /// the dipole neighbourhood). Returns the number of lists rebuilt.
     pub fn update_lists(&self, x: &[DVec3], view: &ParticleView, lists: &mut PairLists) -> u64 {
         let amax = view.radii.iter().copied().fold(0.0, f64::max);
+        let (dipole, contact) = (self.dipole_range(view), self.contact_range(view));
         let mut rebuilt = 0;
         let mut ensure = |list: &mut VerletList, range: f64| {
             if range > 0.0 && range.is_finite() {
                 rebuilt += list.ensure(x, view.exerts, range, list_skin(range, amax)) as u64;
             }
         };
-        if let Some(c) = self.dipole_cutoff {
-            ensure(&mut lists.dipole, c * amax);
+        if self.dipole_cutoff.is_some() {
+            ensure(&mut lists.dipole, dipole);
         }
-        if let Some(m) = self.mie {
-            ensure(&mut lists.contact, 2.0 * amax * m.min_ratio);
+        if self.mie.is_some() {
+            ensure(&mut lists.contact, contact);
         }
         rebuilt
     }
@@ -229,12 +242,13 @@ impl ForceModel {
         };
         let list = &lists.dipole;
         let pair = |i: usize, j: usize, d: DVec3| {
-            let rc = cut * 0.5 * (view.radii[i] + view.radii[j]);
-            if d.length_squared() < rc * rc {
-                dipole_force(d, moments[i], moments[j])
-            } else {
-                DVec3::ZERO
-            }
+            dipole_pair(
+                cut,
+                d,
+                (view.radii[i], view.radii[j]),
+                moments[i],
+                moments[j],
+            )
         };
         // each pair once (the force on its lower index), into its slot; chunks of particles
         // own consecutive slot ranges
@@ -256,11 +270,7 @@ impl ForceModel {
                 let (xi, ai, mi) = (x[i], view.radii[i], moments[i]);
                 for &j in js {
                     let j = j as usize;
-                    let d = xi - x[j];
-                    let rc = cut * 0.5 * (ai + view.radii[j]);
-                    if d.length_squared() < rc * rc {
-                        out[k] = dipole_force(d, mi, moments[j]);
-                    }
+                    out[k] = dipole_pair(cut, xi - x[j], (ai, view.radii[j]), mi, moments[j]);
                     k += 1;
                 }
             }
@@ -330,10 +340,7 @@ impl ForceModel {
         let (ai, mi) = (view.radii[i], moments[i]);
         let mut sum = DVec3::ZERO;
         lists.dipole.for_each_neighbour(x, i, range, |j, d| {
-            let rc = cut * 0.5 * (ai + view.radii[j]);
-            if d.length_squared() < rc * rc {
-                sum += dipole_force(d, mi, moments[j]);
-            }
+            sum += dipole_pair(cut, d, (ai, view.radii[j]), mi, moments[j]);
         });
         sum
     }
@@ -346,11 +353,11 @@ impl ForceModel {
         lists: &PairLists,
         out: &mut [DVec3],
     ) {
-        let Some(mie) = self.mie else {
+        if self.mie.is_none() {
             out.fill(DVec3::ZERO);
             return;
-        };
-        let range = 2.0 * view.radii.iter().copied().fold(0.0, f64::max) * mie.min_ratio;
+        }
+        let range = self.contact_range(view);
         par_fill(out, |i, f| {
             *f = self.contact_force_on(x, view, lists, range, i)
         });
