@@ -234,6 +234,25 @@ pub fn prepare_brownian_step(
     stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
 }
 
+/// Call `f(k, item)` while the query's items come in the order of `entities` (the usual case:
+/// particles spawned in `ParticleId` order share one table); returns how many matched, so the
+/// caller looks the rest up by entity.
+fn in_workspace_order<T>(
+    entities: &[Entity],
+    items: impl Iterator<Item = (Entity, T)>,
+    mut f: impl FnMut(usize, T),
+) -> usize {
+    let mut k = 0;
+    for (e, item) in items {
+        if entities.get(k) != Some(&e) {
+            break;
+        }
+        f(k, item);
+        k += 1;
+    }
+    k
+}
+
 /// `set(component, values[k])` for the k-th workspace entity: one linear pass over the query
 /// while it yields the workspace's entities in order (the usual case: particles spawned in
 /// `ParticleId` order share one table), lookups by entity for the rest.
@@ -244,14 +263,9 @@ fn write_dense<T: Component<Mutability = bevy_ecs::component::Mutable>>(
     set: impl Fn(&mut T, DVec3),
 ) {
     let n = ws.entities.len().min(values.len());
-    let mut k = 0;
-    for (e, mut c) in q.iter_mut() {
-        if k >= n || ws.entities[k] != e {
-            break;
-        }
-        set(&mut c, values[k]);
-        k += 1;
-    }
+    let k = in_workspace_order(&ws.entities[..n], q.iter_mut(), |k, mut c| {
+        set(&mut c, values[k])
+    });
     for (e, v) in ws.entities[k..n].iter().zip(&values[k..n]) {
         if let Ok((_, mut c)) = q.get_mut(*e) {
             set(&mut c, *v);
@@ -375,14 +389,7 @@ pub fn integrate_brownian(
         extra[k] = f.0 - model;
     };
     // a linear pass while the query follows the workspace order, lookups for the rest
-    let mut k = 0;
-    for (e, row) in forces.iter() {
-        if k >= n || ws.entities[k] != e {
-            break;
-        }
-        split(k, row);
-        k += 1;
-    }
+    let k = in_workspace_order(&ws.entities, forces.iter(), &mut split);
     for (k, e) in ws.entities.iter().enumerate().skip(k) {
         if let Ok((_, row)) = forces.get(*e) {
             split(k, row);
@@ -479,15 +486,11 @@ pub fn write_back_brownian(
             r.0.clone_from(&ws.rngs[k]);
         };
     // a linear pass while the query follows the workspace order, lookups for the rest
-    let n = ws.entities.len();
-    let mut k = 0;
-    for (e, p, c, r) in q.iter_mut() {
-        if k >= n || ws.entities[k] != e {
-            break;
-        }
-        write(k, p, c, r);
-        k += 1;
-    }
+    let k = in_workspace_order(
+        &ws.entities,
+        q.iter_mut().map(|(e, p, c, r)| (e, (p, c, r))),
+        |k, (p, c, r)| write(k, p, c, r),
+    );
     for (k, e) in ws.entities.iter().enumerate().skip(k) {
         if let Ok((_, p, c, r)) = q.get_mut(*e) {
             write(k, p, c, r);
