@@ -10,7 +10,9 @@ use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_plugins::app::{SimApp, SimPlugin};
 use magsep_plugins::group::PipelineGroup;
-use magsep_plugins::record::{FibreShape, PluginInfo, RecordingMetadata, RecordingWriter};
+use magsep_plugins::record::{
+    FibreShape, FrameBuffering, PluginInfo, RecordingMetadata, RecordingWriter,
+};
 use magsep_plugins::recorder::{Recorder, record_now, recording_error};
 use serde_json::Value;
 
@@ -345,6 +347,9 @@ fn open_recording(
         extra: Default::default(),
     };
     let mut writer = RecordingWriter::create(path, &meta)?;
+    if !scene.record.as_ref().is_some_and(|r| r.flush_every_frame) {
+        writer.buffer_frames(Some(FrameBuffering::default()));
+    }
     let mut fibres: Vec<_> = app
         .world
         .query::<(&FibreId, &Fibre)>()

@@ -236,6 +236,11 @@ pub struct BrownianConfig {
     pub captured_interact: bool,
     /// Sample the capture curve every this many steps. Default: steps / 200.
     pub observe_every: u64,
+    /// Relative size ε of the field patches (the fibres' field from a Taylor expansion about
+    /// lattice nodes spaced ≤ ε × the distance to the nearest fibre); `None` (default): the
+    /// exact field at every evaluation.
+    #[serde(default)]
+    pub field_patch: Option<f64>,
 }
 
 impl BrownianConfig {

@@ -182,14 +182,40 @@ const FIBRE_COLOUR: [f32; 4] = [0.55, 0.57, 0.62, 1.0];
 /// entity `fibres` (one cylinder per fibre) when there are fibres.
 ///
 /// `frame`'s arrays must have equal lengths; `colours`, if given, one entry per particle.
+#[cfg(test)]
 pub(crate) fn scene_update(
     frame: &ParticleFrame,
     colours: Option<&[[f32; 4]]>,
     decor: &SceneDecor,
     log_time_ns: u64,
 ) -> SceneUpdate {
-    let fibres = &decor.fibres;
     let stamp = timestamp(log_time_ns);
+    let mut entities = frame_entities(frame, colours, decor, Some(stamp));
+    entities.extend(static_entities(decor, Some(stamp)));
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities,
+    }
+}
+
+/// An empty entity `id` in the scene frame with timestamp `stamp`, kept until replaced.
+fn entity(id: &str, stamp: Option<Timestamp>) -> SceneEntity {
+    SceneEntity {
+        timestamp: stamp,
+        frame_id: SCENE_FRAME_ID.into(),
+        id: id.into(),
+        lifetime: Some(Duration::new(0, 0)),
+        ..Default::default()
+    }
+}
+
+/// The entities that change from frame to frame: particles, box outline, walls.
+fn frame_entities(
+    frame: &ParticleFrame,
+    colours: Option<&[[f32; 4]]>,
+    decor: &SceneDecor,
+    stamp: Option<Timestamp>,
+) -> Vec<SceneEntity> {
     let mut spheres = Vec::with_capacity(frame.ids.len());
     let mut cylinders = Vec::new();
     for i in 0..frame.ids.len() {
@@ -227,13 +253,7 @@ pub(crate) fn scene_update(
             spheres.push(sphere(c - h * axis));
         }
     }
-    let entity = |id: &str| SceneEntity {
-        timestamp: Some(stamp),
-        frame_id: SCENE_FRAME_ID.into(),
-        id: id.into(),
-        lifetime: Some(Duration::new(0, 0)),
-        ..Default::default()
-    };
+    let entity = |id: &str| entity(id, stamp);
     let particles = SceneEntity {
         spheres,
         cylinders,
@@ -264,6 +284,14 @@ pub(crate) fn scene_update(
     if let Some(w) = decor.walls {
         entities.push(wall_entity(w, frame.box_edges, entity(WALLS_ENTITY)));
     }
+    entities
+}
+
+/// The entities that are the same in every frame but for their timestamp: backdrop, fibres.
+fn static_entities(decor: &SceneDecor, stamp: Option<Timestamp>) -> Vec<SceneEntity> {
+    let fibres = &decor.fibres;
+    let entity = |id: &str| entity(id, stamp);
+    let mut entities = Vec::new();
     if !decor.backdrop.is_empty() {
         entities.push(SceneEntity {
             cubes: decor
@@ -301,8 +329,46 @@ pub(crate) fn scene_update(
             ..entity(FIBRES_ENTITY)
         });
     }
+    entities
+}
+
+/// [`scene_update`] encoded into `out` (cleared first), byte for byte as prost encodes it,
+/// with the static entities (backdrop, fibres) encoded once into `cache` and reused: they
+/// are most of the bytes of a small frame (a magnet's colour map, a filter's fibres). prost
+/// writes a message's fields in tag order, so an entity's encoding is its timestamp (tag 1)
+/// followed by the encoding of the same entity without one.
+pub(crate) fn encode_scene_update(
+    frame: &ParticleFrame,
+    colours: Option<&[[f32; 4]]>,
+    decor: &SceneDecor,
+    log_time_ns: u64,
+    cache: &mut Option<Vec<Vec<u8>>>,
+    out: &mut Vec<u8>,
+) {
+    use prost::Message;
+    use prost::encoding::{WireType, encode_key, encode_varint};
+    let stamp = timestamp(log_time_ns);
+    out.clear();
     SceneUpdate {
         deletions: Vec::new(),
-        entities,
+        entities: frame_entities(frame, colours, decor, Some(stamp)),
+    }
+    .encode_raw(out);
+    let bodies = cache.get_or_insert_with(|| {
+        static_entities(decor, None)
+            .iter()
+            .map(Message::encode_to_vec)
+            .collect()
+    });
+    let stamp_bytes = SceneEntity {
+        timestamp: Some(stamp),
+        ..Default::default()
+    }
+    .encode_to_vec();
+    for body in bodies.iter() {
+        encode_key(2, WireType::LengthDelimited, out);
+        encode_varint((stamp_bytes.len() + body.len()) as u64, out);
+        out.extend_from_slice(&stamp_bytes);
+        out.extend_from_slice(body);
     }
 }

@@ -243,6 +243,11 @@ pub struct RecordSection {
     /// Record a frame every this many steps (and the final one). Default 100. Range >= 1.
     #[serde(default = "default_every")]
     pub every: u64,
+    /// End a chunk and flush the file at every frame. Default false: frames share a chunk for
+    /// up to 1 s of wall time or 1 MiB, so a process killed without warning loses at most the
+    /// frames of the last second (SIGINT, SIGTERM and errors still flush everything).
+    #[serde(default)]
+    pub flush_every_frame: bool,
 }
 
 fn default_every() -> u64 {

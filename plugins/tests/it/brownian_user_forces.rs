@@ -54,6 +54,7 @@ fn world(n: u64, dt: f64, steps: u64, control: StepControl) -> SimApp {
         dipole_cutoff: None,
         captured_interact: true,
         observe_every: steps.max(1),
+        field_patch: None,
     });
     w.insert_resource(ExternalField {
         flux_density: DVec3::ZERO,

@@ -74,3 +74,54 @@ fn a_zero_wait_writes_every_frame_at_once() {
     let bytes = std::fs::read(&path).unwrap();
     assert_eq!(chunk_count(&bytes), 1 + frames.len());
 }
+
+/// A sink in memory that counts the syncs asked of it.
+struct CountingSink {
+    inner: std::io::Cursor<Vec<u8>>,
+    syncs: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+}
+
+impl std::io::Write for CountingSink {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.inner.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl std::io::Seek for CountingSink {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.inner.seek(pos)
+    }
+}
+
+impl crate::RecordingSink for CountingSink {
+    fn sync(&mut self) -> std::io::Result<()> {
+        self.syncs.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Ok(())
+    }
+}
+
+#[test]
+fn finish_syncs_only_when_asked() {
+    use std::sync::atomic::Ordering;
+    for synced in [false, true] {
+        let syncs = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let sink = CountingSink {
+            inner: std::io::Cursor::new(Vec::new()),
+            syncs: syncs.clone(),
+        };
+        let name = std::path::Path::new("counting.mcap");
+        let mut w = RecordingWriter::from_sink(name, Box::new(sink), &metadata()).unwrap();
+        for f in &random_frames(13, 3, true) {
+            w.write_frame(f, None).unwrap();
+        }
+        if synced {
+            w.finish_synced().unwrap();
+        } else {
+            w.finish().unwrap();
+        }
+        assert_eq!(syncs.load(Ordering::Relaxed), usize::from(synced));
+    }
+}

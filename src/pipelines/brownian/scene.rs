@@ -90,6 +90,9 @@ pub struct BrownianSection {
     /// Capture-curve sampling interval in steps. Default: steps / 200 (at least 1).
     #[serde(default)]
     pub observe_every: Option<u64>,
+    /// Relative field-patch size ε in [1e-6, 0.5]; default: the exact field everywhere.
+    #[serde(default)]
+    pub field_patch: Option<f64>,
 }
 
 impl BrownianSection {
@@ -116,6 +119,7 @@ impl BrownianSection {
             },
             captured_interact: self.captured_interact.unwrap_or(true),
             observe_every: self.observe_every.unwrap_or((steps / 200).max(1)),
+            field_patch: self.field_patch,
         }
     }
 
@@ -168,6 +172,14 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
     if let Some(v) = b.viscosity {
         let (lo, hi) = VISCOSITY_RANGE;
         within(errors, "brownian.viscosity", v, lo, hi, "[Pa s]");
+    }
+    if let Some(e) = b.field_patch
+        && !(1e-6..=0.5).contains(&e)
+    {
+        errors.push(SceneError::new(
+            "brownian.field_patch",
+            format!("must be in [1e-6, 0.5], got {e}"),
+        ));
     }
     if let Some(t) = b.krylov_tolerance
         && !(t.is_finite() && t > 0.0 && t <= 0.1)

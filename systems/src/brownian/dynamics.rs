@@ -254,10 +254,12 @@ impl LocalDynamics for PipelineDynamics<'_> {
         self.list_builds += self.model.update_lists(x, &view, self.lists);
         let mut moments = self.start_moments.to_vec();
         moments.resize(x.len(), DVec3::ZERO);
+        self.lists.patches.ensure(x.len());
         let mut f: Vec<DVec3> = active
             .iter()
             .map(|&i| {
-                let (m, field) = self.model.moment_and_field_force(x, &view, i);
+                let slot = &mut self.lists.patches.slots[i];
+                let (m, field) = self.model.moment_and_field_force(x, &view, i, slot);
                 moments[i] = m;
                 field + self.extra[i]
             })

@@ -9,6 +9,7 @@ pub mod dynamics;
 pub mod hydro;
 pub mod model;
 pub mod pair;
+pub mod patch;
 pub mod stepper;
 pub mod systems;
 pub mod verlet;

@@ -20,6 +20,7 @@ use magsep_components::brownian::MomentModel;
 use rayon::prelude::*;
 
 use super::pair::{Mie, dipole_force};
+use super::patch::{FieldPatches, Patch, patched_field};
 use super::verlet::VerletList;
 use crate::field::{CylinderSource, FieldGradient, total_field, total_field_gradient};
 
@@ -67,13 +68,16 @@ impl ForceParts {
     }
 }
 
-/// The neighbour lists of the pair forces, cached across evaluations.
+/// The state the force model caches across evaluations: the neighbour lists of the pair
+/// forces and the particles' field patches.
 #[derive(Debug, Clone, Default)]
 pub struct PairLists {
     /// Pairs within the dipole cut-off (used when the model has one).
     pub dipole: VerletList,
     /// Pairs within the Mie range (used when the model has a soft core).
     pub contact: VerletList,
+    /// Field-patch memos (used when the model has a patch size).
+    pub patches: FieldPatches,
 }
 
 impl PairLists {
@@ -110,6 +114,8 @@ pub struct ForceModel {
     pub mie: Option<Mie>,
     /// Dipole cut-off in units of the pair's mean radius (None: no dipole forces).
     pub dipole_cutoff: Option<f64>,
+    /// Relative field-patch size ε ([`super::patch`]); None: the exact field everywhere.
+    pub field_patch: Option<f64>,
 }
 
 /// Dipole force on `i` \[N\] from `j` at `d = x_i − x_j` within the pair's cut-off `cut` × mean
@@ -150,29 +156,35 @@ impl ForceModel {
         b * (law.magnitude(bm, self.kt) / bm)
     }
 
-    /// The field and its gradient at `p` (uniform applied field when there are no fibres).
-    pub fn field_gradient(&self, p: DVec3) -> FieldGradient {
+    /// The field and its gradient at `p` (uniform applied field when there are no fibres),
+    /// exact or from the patch memo `slot` of a particle of radius `a` \[m\].
+    pub fn field_gradient(&self, p: DVec3, a: f64, slot: &mut Option<Patch>) -> FieldGradient {
         if self.sources.is_empty() {
             return FieldGradient {
                 b: self.b_ext,
                 grad_b: glam::DMat3::ZERO,
             };
         }
-        total_field_gradient(&self.sources, self.b_ext, p, self.tolerance)
+        match self.field_patch {
+            Some(eps) => patched_field(&self.sources, self.b_ext, self.tolerance, eps, a, p, slot),
+            None => total_field_gradient(&self.sources, self.b_ext, p, self.tolerance),
+        }
     }
 
-    /// Moment [A m²] and field force \[N\] of particle `i` (the force only when it is mobile).
+    /// Moment [A m²] and field force \[N\] of particle `i` (the force only when it is mobile);
+    /// `slot` is its field-patch memo.
     pub fn moment_and_field_force(
         &self,
         x: &[DVec3],
         view: &ParticleView,
         i: usize,
+        slot: &mut Option<Patch>,
     ) -> (DVec3, DVec3) {
         let law = &view.moments[i];
         if !law.is_magnetic() {
             (DVec3::ZERO, DVec3::ZERO)
         } else if view.mobile[i] && !self.sources.is_empty() {
-            let g = self.field_gradient(x[i]);
+            let g = self.field_gradient(x[i], view.radii[i], slot);
             (
                 self.moment(law, g.b),
                 crate::field::dipole_force(&g, law, self.kt),
@@ -180,6 +192,8 @@ impl ForceModel {
         } else {
             let b = if self.sources.is_empty() {
                 self.b_ext
+            } else if self.field_patch.is_some() {
+                self.field_gradient(x[i], view.radii[i], slot).b
             } else {
                 total_field(&self.sources, self.b_ext, x[i], self.tolerance).b
             };
@@ -193,16 +207,23 @@ impl ForceModel {
         &self,
         x: &[DVec3],
         view: &ParticleView,
+        patches: &mut FieldPatches,
         moments: &mut [DVec3],
         field: &mut [DVec3],
     ) {
-        let mut pairs = vec![(DVec3::ZERO, DVec3::ZERO); x.len()];
-        par_fill(&mut pairs, |i, o| {
-            *o = self.moment_and_field_force(x, view, i)
+        patches.ensure(x.len());
+        let mut work: Vec<((DVec3, DVec3), Option<Patch>)> = patches
+            .slots
+            .iter()
+            .map(|s| ((DVec3::ZERO, DVec3::ZERO), *s))
+            .collect();
+        par_fill(&mut work, |i, (o, slot)| {
+            *o = self.moment_and_field_force(x, view, i, slot)
         });
-        for (i, (m, f)) in pairs.into_iter().enumerate() {
+        for (i, ((m, f), slot)) in work.into_iter().enumerate() {
             moments[i] = m;
             field[i] = f;
+            patches.slots[i] = slot;
         }
     }
 
@@ -407,7 +428,13 @@ impl ForceModel {
         if parts.field.len() != n {
             *parts = ForceParts::zeros(n);
         }
-        self.moments_and_field(x, view, &mut parts.moments, &mut parts.field);
+        self.moments_and_field(
+            x,
+            view,
+            &mut lists.patches,
+            &mut parts.moments,
+            &mut parts.field,
+        );
         self.update_lists(x, view, lists);
         let moments = std::mem::take(&mut parts.moments);
         self.dipole_forces(x, &moments, view, lists, &mut parts.dipole);
@@ -447,6 +474,7 @@ mod tests {
             kt: 4e-21,
             mie: None,
             dipole_cutoff: Some(12.0),
+            field_patch: None,
         };
         // captured particles that keep interacting, and ones that do not
         let mobile: Vec<bool> = (0..n).map(|i| i % 7 != 2).collect();
@@ -495,6 +523,7 @@ mod tests {
             kt: 4e-21,
             mie: Some(Mie::new(4e-19, 30.0, 15.0)),
             dipole_cutoff: Some(10.0),
+            field_patch: None,
         };
         let laws = vec![MomentModel::Saturated { moment: 1e-16 }; n];
         let (radii, mobile) = (vec![a; n], vec![true; n]);

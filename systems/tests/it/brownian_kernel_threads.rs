@@ -36,6 +36,7 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
         kt,
         mie: None,
         dipole_cutoff: None,
+        field_patch: None,
     };
     let radii = vec![a; n];
     let laws = vec![MomentModel::default(); n];
