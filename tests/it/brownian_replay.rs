@@ -29,6 +29,7 @@ moment = { kind = "saturated", moment = 5.151e-16 }
 placement = { kind = "fibre_top", fibre = 0, gap = 1e-6, height = 20e-6 }
 [record]
 every = 60
+flush_every_frame = true   # one chunk per frame, so that a cut in the middle keeps frames
 "#;
 
 fn bits(f: &magsep::plugins::record::ParticleFrame) -> Vec<u64> {

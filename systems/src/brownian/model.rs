@@ -212,18 +212,24 @@ impl ForceModel {
         field: &mut [DVec3],
     ) {
         patches.ensure(x.len());
-        let mut work: Vec<((DVec3, DVec3), Option<Patch>)> = patches
-            .slots
-            .iter()
-            .map(|s| ((DVec3::ZERO, DVec3::ZERO), *s))
-            .collect();
-        par_fill(&mut work, |i, (o, slot)| {
-            *o = self.moment_and_field_force(x, view, i, slot)
-        });
-        for (i, ((m, f), slot)) in work.into_iter().enumerate() {
-            moments[i] = m;
-            field[i] = f;
-            patches.slots[i] = slot;
+        let go = |(i, ((m, f), slot)): (usize, ((&mut DVec3, &mut DVec3), &mut Option<Patch>))| {
+            (*m, *f) = self.moment_and_field_force(x, view, i, slot);
+        };
+        if x.len() < 512 {
+            moments
+                .iter_mut()
+                .zip(field.iter_mut())
+                .zip(patches.slots.iter_mut())
+                .enumerate()
+                .for_each(go);
+        } else {
+            moments
+                .par_iter_mut()
+                .zip(field.par_iter_mut())
+                .zip(patches.slots.par_iter_mut())
+                .with_min_len(128)
+                .enumerate()
+                .for_each(go);
         }
     }
 
