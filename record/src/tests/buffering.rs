@@ -98,7 +98,8 @@ impl std::io::Seek for CountingSink {
 
 impl crate::RecordingSink for CountingSink {
     fn sync(&mut self) -> std::io::Result<()> {
-        self.syncs.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.syncs
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Ok(())
     }
 }

@@ -580,8 +580,11 @@ fn cached_scene_encoding_equals_the_full_encoding_bit_for_bit() {
     for (k, frame) in random_frames(21, 4, true).iter().enumerate() {
         let log_time = 1_000_000_007 * k as u64 + 3;
         let mut full = Vec::new();
-        foxglove::Encode::encode(&scene::scene_update(frame, None, &decor, log_time), &mut full)
-            .unwrap();
+        foxglove::Encode::encode(
+            &scene::scene_update(frame, None, &decor, log_time),
+            &mut full,
+        )
+        .unwrap();
         scene::encode_scene_update(frame, None, &decor, log_time, &mut cache, &mut fast);
         assert_eq!(fast, full, "frame {k}");
     }

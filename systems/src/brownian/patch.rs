@@ -80,7 +80,7 @@ fn spacing(level: u64) -> f64 {
 fn cell(p: DVec3, level: u64) -> Option<([i64; 3], DVec3)> {
     let h = spacing(level);
     let r = (p / h).floor();
-    if !(r.abs().max_element() < 4.0e18) {
+    if !r.is_finite() || r.abs().max_element() >= 4.0e18 {
         return None;
     }
     let key = [r.x as i64, r.y as i64, r.z as i64];
@@ -187,7 +187,10 @@ mod tests {
             assert!(h <= eps * dist(q), "h {h} eps d {}", eps * dist(q));
             for coarser in level + 1..level + 4 {
                 let (_, qc) = cell(p, coarser).unwrap();
-                assert!(spacing(coarser) > eps * dist(qc), "level {coarser} qualifies too");
+                assert!(
+                    spacing(coarser) > eps * dist(qc),
+                    "level {coarser} qualifies too"
+                );
             }
             assert!((p - q).abs().max_element() <= h / 2.0);
             assert_eq!((key[0] as f64 + 0.5) * h, q.x);
@@ -226,7 +229,12 @@ mod tests {
                 let mut slot = None;
                 let approx = patched_field(&src, b_ext, 1e-12, eps, 75e-9, p, &mut slot);
                 eb = eb.max((approx.b - exact.b).length() / exact.b.length());
-                let gn = exact.grad_b.to_cols_array().iter().map(|v| v * v).sum::<f64>();
+                let gn = exact
+                    .grad_b
+                    .to_cols_array()
+                    .iter()
+                    .map(|v| v * v)
+                    .sum::<f64>();
                 let diff = (approx.grad_b - exact.grad_b).to_cols_array();
                 eg = eg.max((diff.iter().map(|v| v * v).sum::<f64>() / gn).sqrt());
                 // the memo is reused at the same point and gives the same value

@@ -229,13 +229,8 @@ pub fn prepare_brownian_step(
     );
     m.resize(n, DVec3::ZERO);
     f.resize(n, DVec3::ZERO);
-    ws.model.moments_and_field(
-        &ws.positions,
-        &view,
-        &mut ws.lists.patches,
-        &mut m,
-        &mut f,
-    );
+    ws.model
+        .moments_and_field(&ws.positions, &view, &mut ws.lists.patches, &mut m, &mut f);
     (ws.moments, ws.field) = (m, f);
     stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
 }
