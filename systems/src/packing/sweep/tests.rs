@@ -16,21 +16,24 @@ const SUPERBALL: Shape = Shape::Superquadric {
     exponents: DVec3::splat(3.0),
 };
 
-/// `n` bodies of `shape` inserted at phi 0.3 and compressed to about `phi` (overlapping).
+/// `n` bodies of `shape` inserted at phi min(`phi`, 0.3) and compressed to `phi` (overlapping
+/// above 0.3).
 fn overlapping(shape: Shape, n: usize, phi: f64, seed: u64) -> (PackingState, NeighbourList) {
     let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
     let v: f64 = bodies.iter().map(|b| b.volume).sum();
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
     let mut state = random_insertion(
         &bodies,
-        PackingState::periodic_cube((v / 0.3).cbrt()),
+        PackingState::periodic_cube((v / phi.min(0.3)).cbrt()),
         &mut rngs,
     )
     .unwrap();
     let mut list = NeighbourList::new(0.1);
     list.build(&mut state);
-    let dv = state.container_volume() - v / phi;
-    compress(&mut state, &mut list, dv);
+    if phi > 0.3 {
+        let dv = state.container_volume() - v / phi;
+        compress(&mut state, &mut list, dv);
+    }
     list.ensure(&mut state);
     (state, list)
 }
@@ -172,4 +175,31 @@ fn remove_overlaps_uses_the_pool_and_keeps_the_serial_result() {
     assert_eq!(oa, ob);
     assert!(bits(&a) == bits(&b));
     assert!(oa.attempts > 1000, "{oa:?}");
+}
+
+#[test]
+#[ignore = "timing (release): 750 superballs, 300 compression steps on 1 and 2 threads"]
+fn superballs_750_steps_on_one_and_two_threads() {
+    let n = 750;
+    let mut cfg = PackingConfig::defaults_for(n, 1.0);
+    cfg.scheme = OverlapRemovalScheme::Revised;
+    cfg.max_attempts = PackingConfig::default_max_attempts(cfg.scheme, n);
+    cfg.max_compression_steps = 300;
+    let p = DriverParams::from_config(&cfg, 1.0);
+    let run = |threads: usize| {
+        let (mut state, mut list) = overlapping(SUPERBALL, n, 0.05, 1);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        let t = std::time::Instant::now();
+        let st = pool(threads).install(|| run_to_end(&p, &mut state, &mut list, &mut rng, |_| {}));
+        let s = t.elapsed().as_secs_f64();
+        eprintln!(
+            "threads {threads}: {s:.2} s, phi {:.4}, attempts {}, contacts {}",
+            st.packing_fraction, st.attempts, st.contact_evaluations
+        );
+        (bits(&state), st)
+    };
+    let (one, st1) = run(1);
+    let (two, st2) = run(2);
+    assert_eq!(st1, st2);
+    assert!(one == two);
 }
