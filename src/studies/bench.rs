@@ -295,6 +295,19 @@ pub fn bench(what: BenchKind, as_json: bool, quick: bool) -> Result<(), BenchErr
         as_json,
         json!({"name": "packing_spheres_to_jamming", "particles": n_small, "threads": 1, "wall_time_s": wall, "attempts_per_s": attempts / wall, "packing_fraction": summary["packing_fraction"], "mean_contact_number": summary["mean_contact_number"], "steps": summary["compression_steps"], "path": "scene"}),
     )?;
+    // 1b. superballs (thesis size, revised scheme) through the scene pipeline, 1 and 2 threads
+    let (n_sb, sb_steps) = if quick { (100, 60) } else { (750, 300) };
+    let mut sb_phi = Vec::new();
+    for t in [1, 2] {
+        let (summary, wall) = crate::studies::bench_scene::superballs_scene_run(n_sb, sb_steps, t)?;
+        let attempts = summary["attempts"].as_f64().unwrap_or(f64::NAN);
+        sb_phi.push(summary["packing_fraction"].clone());
+        emit(
+            &mut rows,
+            as_json,
+            json!({"name": "packing_superballs_steps", "particles": n_sb, "threads": t, "steps": sb_steps, "wall_time_s": wall, "attempts_per_s": attempts / wall, "packing_fraction": summary["packing_fraction"], "contact_evaluations": summary["contact_evaluations"], "same_as_one_thread": sb_phi[0] == summary["packing_fraction"], "path": "scene"}),
+        )?;
+    }
     let cfg = PackingConfig::defaults_for(n_small, 1.0);
     // 2. rods of aspect ratio 5 to the jammed state
     let rod = Shape::Spherocylinder {

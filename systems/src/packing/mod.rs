@@ -3,7 +3,7 @@
 //! Kernels on dense arrays in reduced units ([`state`], bodies in [`body`]): contacts
 //! ([`contact`]), user force kernels in reduced units ([`external`]), the Verlet
 //! list over all periodic images ([`neighbour`]), the move rules ([`moves`]), overlap-removal
-//! sweeps ([`removal`]), FIRE ([`fire`]) with its sphere-pair force kernel ([`sphere_pairs`]),
+//! sweeps ([`removal`], made parallel and deterministic in [`sweep`]), FIRE ([`fire`]) with its sphere-pair force kernel ([`sphere_pairs`]),
 //! the compression driver ([`compress`]), random insertion ([`insert`]).
 //! The ECS glue is in [`systems`].
 
@@ -18,5 +18,6 @@ pub mod neighbour;
 pub mod removal;
 pub mod sphere_pairs;
 pub mod state;
+pub mod sweep;
 pub mod systems;
 pub mod walls;

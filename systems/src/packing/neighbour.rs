@@ -189,6 +189,8 @@ pub struct NeighbourList {
     warm: Vec<Option<WarmStart>>,
     /// Each unordered pair once, in [`Self::unique_entries`] order.
     pairs: Vec<PairEntry>,
+    /// For every directed entry, the index in [`Self::unique`] of its unordered pair.
+    pair_of_entry: Vec<u32>,
     /// Centres at the last build, scaled with every compression since / D (the reference of
     /// [`Self::note_displacements`]).
     reference: Vec<DVec3>,
@@ -373,14 +375,19 @@ impl NeighbourList {
             };
             self.start[n] as usize
         ];
+        // the two directed entries of each pair point at each other
+        let mut twin = vec![0u32; self.start[n] as usize];
         for &(i, j, shift) in &pairs {
             let image = image_of(shift, state.edges);
-            self.entries[fill[i as usize] as usize] = Neighbour { j, image };
-            fill[i as usize] += 1;
-            self.entries[fill[j as usize] as usize] = Neighbour {
+            let (ki, kj) = (fill[i as usize], fill[j as usize] + u32::from(i == j));
+            self.entries[ki as usize] = Neighbour { j, image };
+            self.entries[kj as usize] = Neighbour {
                 j: i,
                 image: image.map(|x| -x),
             };
+            twin[ki as usize] = kj;
+            twin[kj as usize] = ki;
+            fill[i as usize] += 1;
             fill[j as usize] += 1;
         }
         self.warm = vec![None; self.entries.len()];
@@ -395,10 +402,16 @@ impl NeighbourList {
             }
         }
         self.pairs.clear();
+        self.pair_of_entry.clear();
+        self.pair_of_entry.resize(self.entries.len(), u32::MAX);
         for i in 0..n {
             for k in self.start[i] as usize..self.start[i + 1] as usize {
                 let nb = self.entries[k];
                 if nb.j as usize > i || (nb.j as usize == i && nb.image > [0, 0, 0]) {
+                    let idx = self.pairs.len() as u32;
+                    let other = twin.get(k).map_or(k, |t| *t as usize);
+                    self.pair_of_entry[k] = idx;
+                    self.pair_of_entry[other] = idx;
                     self.pairs.push(PairEntry {
                         i: i as u32,
                         j: nb.j,
@@ -441,6 +454,18 @@ impl NeighbourList {
     #[inline]
     pub fn entry(&self, k: usize) -> Neighbour {
         self.entries[k]
+    }
+
+    /// The index in [`Self::unique`] of the unordered pair of directed entry `k`.
+    #[inline]
+    pub fn pair_of_entry(&self, k: usize) -> usize {
+        self.pair_of_entry[k] as usize
+    }
+
+    /// The cached contact solution of entry `k` (a copy).
+    #[inline]
+    pub fn warm(&self, k: usize) -> Option<WarmStart> {
+        self.warm[k]
     }
 
     /// The cached contact solution of entry `k`.

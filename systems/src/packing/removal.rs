@@ -6,14 +6,18 @@
 //! one single-particle move (the thesis's try: ~200 N per compression step, [T000 §3.2]). The run
 //! succeeds when no overlap above the tolerance remains, and fails when the attempt budget is
 //! spent first.
+//!
+//! The scans and sweeps run on the current rayon pool with results independent of the thread
+//! count ([`super::sweep`]); [`overlap_scan`] is the serial full scan they are tested against.
 
 use glam::DQuat;
 use rand::Rng;
 use rand::seq::SliceRandom;
 
-use super::moves::{MoveContact, MoveRule, overlap_removal_move};
+use super::moves::{MoveContact, MoveRule};
 use super::neighbour::NeighbourList;
 use super::state::{Body, BodyKind, PackingState};
+use super::sweep::{OverlapTracker, batch_for_threads, commit, contacts_of, propose, sweep};
 
 /// Result of [`remove_overlaps`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,7 +35,7 @@ pub struct RemovalOutcome {
 }
 
 /// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls,
-/// written into `out`.
+/// written into `out` (the pairs' cached Newton starts updated).
 pub fn overlapping_contacts(
     state: &PackingState,
     list: &mut NeighbourList,
@@ -39,18 +43,12 @@ pub fn overlapping_contacts(
     tol: f64,
     out: &mut Vec<MoveContact>,
 ) {
-    out.clear();
+    let mut warm = Vec::new();
+    contacts_of(state, list, i, tol, out, &mut warm);
     let first = list.entry_start(i);
-    for k in first..first + list.of(i).len() {
-        let nb = list.entry(k);
-        let c = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), list.warm_mut(k));
-        if c.overlap > tol {
-            out.push(MoveContact::from(&c));
-        }
+    for (k, w) in warm.into_iter().enumerate() {
+        *list.warm_mut(first + k) = w;
     }
-    let mut walls = Vec::new();
-    state.wall_contacts(i, -tol, &mut walls);
-    out.extend(walls.iter().map(MoveContact::from));
 }
 
 /// Result of [`overlap_scan`].
@@ -66,7 +64,8 @@ pub struct OverlapScan {
     pub fallbacks: u64,
 }
 
-/// Total overlap (pairs and walls) and the flags of particles with an overlap above `tol`.
+/// Total overlap (pairs and walls) and the flags of particles with an overlap above `tol`:
+/// every pair evaluated serially (the reference of [`OverlapTracker::scan`]).
 pub fn overlap_scan(
     state: &PackingState,
     list: &mut NeighbourList,
@@ -132,18 +131,12 @@ pub fn move_particle(
     scratch: &mut Vec<MoveContact>,
     rng: &mut impl Rng,
 ) -> bool {
-    overlapping_contacts(state, list, i, tol, scratch);
-    let body = state.bodies[i];
-    let Some(d) = overlap_removal_move(rule, &body, state.orientations[i], scratch, rng) else {
-        return false;
-    };
-    state.positions[i] += d.dx;
-    state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
-    list.note_move(i, d.dx, turn_bound(&body, d.rotation));
-    true
+    let p = propose(state, list, i, rule, tol, scratch, rng);
+    commit(state, list, i, &p)
 }
 
-/// Remove overlaps above `tol` with at most `budget` single-particle moves.
+/// Remove overlaps above `tol` with at most `budget` single-particle moves, on the threads of
+/// the current rayon pool (the same result for any number: [`super::sweep`]).
 pub fn remove_overlaps(
     state: &mut PackingState,
     list: &mut NeighbourList,
@@ -152,15 +145,28 @@ pub fn remove_overlaps(
     budget: u64,
     rng: &mut impl Rng,
 ) -> RemovalOutcome {
+    remove_overlaps_batched(state, list, rule, tol, budget, batch_for_threads(), rng)
+}
+
+/// [`remove_overlaps`] with `batch` moves proposed at a time (1: the serial sweep).
+pub fn remove_overlaps_batched(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    rule: MoveRule,
+    tol: f64,
+    budget: u64,
+    batch: usize,
+    rng: &mut impl Rng,
+) -> RemovalOutcome {
     let mut attempts = 0;
     let mut sweeps = 0;
     let mut flags = Vec::new();
     let mut order = Vec::new();
-    let mut scratch = Vec::new();
+    let mut tracker = OverlapTracker::new();
     let (mut contacts, mut fallbacks) = (0, 0);
     loop {
         list.ensure(state);
-        let scan = overlap_scan(state, list, tol, &mut flags);
+        let scan = tracker.scan(state, list, tol, &mut flags);
         contacts += scan.contacts;
         fallbacks += scan.fallbacks;
         order.clear();
@@ -171,40 +177,34 @@ pub fn remove_overlaps(
                 .filter(|(_, f)| **f)
                 .map(|(i, _)| i),
         );
+        let outcome = |success, attempts| RemovalOutcome {
+            success,
+            attempts,
+            sweeps,
+            contacts,
+            fallbacks,
+        };
         if order.is_empty() {
-            return RemovalOutcome {
-                success: true,
-                attempts,
-                sweeps,
-                contacts,
-                fallbacks,
-            };
+            return outcome(true, attempts);
         }
         if attempts >= budget {
-            return RemovalOutcome {
-                success: false,
-                attempts,
-                sweeps,
-                contacts,
-                fallbacks,
-            };
+            return outcome(false, attempts);
         }
         order.shuffle(rng);
-        let mut moved_any = false;
-        for &i in &order {
-            if attempts >= budget {
-                break;
-            }
-            if list.needs_rebuild() {
-                list.build(state);
-            }
-            if move_particle(state, list, i, rule, tol, &mut scratch, rng) {
-                attempts += 1;
-                moved_any = true;
-            }
-        }
+        let swept = sweep(
+            state,
+            list,
+            &mut tracker,
+            &order,
+            rule,
+            tol,
+            budget,
+            &mut attempts,
+            batch,
+            rng,
+        );
         sweeps += 1;
-        if !moved_any {
+        if swept.moves == 0 {
             // every overlapping particle is stuck (no positive-rate contact): spend the budget
             return RemovalOutcome {
                 success: false,

@@ -65,10 +65,10 @@ pub enum ContactStatus {
     /// The bounding spheres are apart; `overlap = r_a + r_b - |d| < 0` is only an upper bound
     /// (the true gap is at least `-overlap`) and the normal is the centre line.
     FarApart,
-    /// GJK found a gap wider than the cutoff (see [`ContactOptions::gap_cutoff`]); the
-    /// overlap is the support-function value in GJK's direction, an upper bound of the true
-    /// overlap (to GJK precision for an infinite cutoff, otherwise only known to be below
-    /// minus the cutoff).
+    /// GJK, or the separating-axis test along the centre line that runs first, found a gap
+    /// wider than the cutoff (see [`ContactOptions::gap_cutoff`]); the overlap is the
+    /// support-function value in that direction, an upper bound of the true overlap (to GJK
+    /// precision for an infinite cutoff, otherwise only known to be below minus the cutoff).
     SeparatedGjk,
     /// `polish = false`: the GJK/EPA answer, projected onto both surfaces.
     GjkEpa,
@@ -350,6 +350,26 @@ pub fn contact(
             Some(ws),
         )
     };
+    // separating-axis test along the centre line: a gap beyond the cutoff ends here, before
+    // any warm start, GJK or Newton (the same answer class as GJK's early exit)
+    let cutoff = opts.gap_cutoff.max(opts.newton_band * s.scale);
+    if opts.polish && cutoff.is_finite() && dist > 0.0 {
+        let u = s.d / dist;
+        let (ua, ub) = (s.qa.conjugate() * u, s.qb.conjugate() * -u);
+        let (sa, sb) = (s.pa.support(ua), s.pb.support(ub));
+        let bound = ua.dot(sa) + ub.dot(sb) - dist;
+        if bound < -cutoff {
+            return ContactResult {
+                overlap: bound,
+                normal: u,
+                rc_a: s.qa * sa,
+                rc_b: s.qb * sb,
+                status: ContactStatus::SeparatedGjk,
+                iterations: 0,
+                warm: None,
+            };
+        }
+    }
     let mut iterations = 0;
     if opts.polish
         && let Some(w) = warm.filter(|w| w.s_a.is_finite() && w.s_b.is_finite())

@@ -40,7 +40,10 @@
 //!   centre line and then reported as [`ContactStatus::Fallback`] carrying the GJK/EPA
 //!   answer. It is never silently turned into "no contact" as in the thesis ([T000 §4.4.1]).
 //! - Failure mode of [T000 §4.4.2] (bounding spheres too loose): the exact bounding sphere is only the
-//!   cheap reject. GJK decides between separated and penetrating. By default it stops as soon
+//!   cheap reject. Next (finite cutoff only) the separating-axis bound along the centre line,
+//!   h_a(u) + h_b(-u) - |d| with u = d/|d| (two support evaluations), ends pairs whose gap
+//!   is certainly beyond the cutoff before any warm start, GJK or Newton (the listed but
+//!   clearly separated pairs of a packing). GJK decides between separated and penetrating. By default it stops as soon
 //!   as the gap is known to exceed the Newton band (or `gap_cutoff`), or to be below it
 //!   (Newton then computes the gap), so separated pairs are cheap. EPA runs only for
 //!   penetrating pairs without a warm start. A separated result of Newton is certified

@@ -45,11 +45,13 @@ impl Pow {
     }
 }
 
-/// x^e for x >= 0 and e in (0, 1], with square-root fast paths for e = 1/2, 1/4, 1/8.
+/// x^e for x >= 0 and e in (0, 1], with square- and cube-root fast paths for e = 1/2, 1/3,
+/// 1/4, 1/8 (1/3: the superballs of g = 3).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Root {
     One,
     Half,
+    Third,
     Quarter,
     Eighth,
     Real(f64),
@@ -61,6 +63,8 @@ impl Root {
             Root::One
         } else if e == 0.5 {
             Root::Half
+        } else if e == 1.0 / 3.0 {
+            Root::Third
         } else if e == 0.25 {
             Root::Quarter
         } else if e == 0.125 {
@@ -75,6 +79,7 @@ impl Root {
         match self {
             Root::One => x,
             Root::Half => x.sqrt(),
+            Root::Third => x.cbrt(),
             Root::Quarter => x.sqrt().sqrt(),
             Root::Eighth => x.sqrt().sqrt().sqrt(),
             Root::Real(e) => x.powf(e),

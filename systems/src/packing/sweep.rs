@@ -1,0 +1,376 @@
+//! Deterministic multithreaded kernels of the single-particle overlap removal
+//! ([`super::removal`]): the overlap scan and the Gauss-Seidel sweep, both exactly the serial
+//! algorithm's results for any number of rayon threads.
+//!
+//! **Scan** ([`OverlapTracker`]). Which particles carry an overlap above the tolerance. The
+//! pair contacts of the Verlet list ([`NeighbourList::unique`]) are evaluated in parallel into
+//! one result per pair (each pair owns its cached Newton start, so the evaluations are
+//! independent), and the per-pair results are reduced serially in pair order. Between two
+//! scans of one overlap removal only the particles that moved change their contacts, so after
+//! the first (full) scan only the pairs with a moved end are evaluated again; the others keep
+//! their overlap. This is exact up to the contact solver's own accuracy (~1e-13 D): the serial
+//! code it replaces re-solved every pair from its cached solution, which returns the same
+//! overlap to that accuracy. The first scan, and every scan after a list rebuild (the rebuild
+//! wraps the centres and renumbers the pairs), is full.
+//!
+//! **Sweep** ([`sweep`]). The serial sweep moves the flagged particles one after the other in a
+//! shuffled order, each with its contacts evaluated at that moment. The move of particle i
+//! reads only the poses of i and of its listed neighbours and the cached Newton starts of i's
+//! own list entries (which only i's moves write). So the moves of a batch of B particles
+//! (B = 4 x threads) are computed in parallel from the state at the start of the batch
+//! (speculatively), then committed serially in the sweep order: a proposal is used as it is
+//! when no neighbour of i has moved since the batch started, and recomputed at its turn
+//! otherwise (and the batch is cut short when the list needs a rebuild). Every committed move
+//! is therefore bit for bit the move of the serial sweep, for any B and any thread count. Only
+//! the rules without random numbers (revised, original) run in batches; the random-direction
+//! variants of fig. 3.4 use the serial loop.
+
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
+
+use super::moves::{Displacement, MoveContact, MoveRule, overlap_removal_move};
+use super::neighbour::NeighbourList;
+use super::removal::turn_bound;
+use super::state::PackingState;
+use crate::geometry::superquadric::WarmStart;
+
+/// Pairs per rayon task of the pair scan (a sphere pair costs ~20 ns, a superball pair ~1 us).
+const SCAN_CHUNK: usize = 64;
+
+/// Moves proposed per batch and thread of the parallel sweep.
+pub const BATCH_PER_THREAD: usize = 4;
+
+/// The overlaps of the list's pairs between scans of one overlap removal (see the module
+/// header).
+#[derive(Debug, Clone, Default)]
+pub struct OverlapTracker {
+    /// Overlap / D per pair of [`NeighbourList::unique`].
+    overlap: Vec<f64>,
+    /// Per particle: a wall overlap above the tolerance.
+    wall: Vec<bool>,
+    /// `NeighbourList::builds` at the last scan (None: no scan yet).
+    built: Option<u64>,
+    /// Particles moved since the last scan, and their marks.
+    moved: Vec<u32>,
+    moved_mark: Vec<bool>,
+    /// Scratch: pair marks and selected pairs.
+    pair_mark: Vec<bool>,
+    selected: Vec<u32>,
+}
+
+/// Contacts evaluated by one scan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ScanCount {
+    /// Pair contacts evaluated.
+    pub contacts: u64,
+    /// Of which the contact solver fell back to its estimate.
+    pub fallbacks: u64,
+}
+
+impl OverlapTracker {
+    /// A tracker whose next scan is full.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Record that particle `i` moved.
+    pub fn note_moved(&mut self, i: usize) {
+        if self.moved_mark.len() <= i {
+            self.moved_mark.resize(i + 1, false);
+        }
+        if !self.moved_mark[i] {
+            self.moved_mark[i] = true;
+            self.moved.push(i as u32);
+        }
+    }
+
+    /// Force a full scan next time.
+    pub fn invalidate(&mut self) {
+        self.built = None;
+    }
+
+    /// Set `flags[i]` for every particle with a pair or wall overlap above `tol`, evaluating
+    /// the pairs with a moved end (all pairs on the first scan or after a rebuild). The list
+    /// must be valid (`NeighbourList::ensure`).
+    pub fn scan(
+        &mut self,
+        state: &PackingState,
+        list: &mut NeighbourList,
+        tol: f64,
+        flags: &mut Vec<bool>,
+    ) -> ScanCount {
+        let n = state.len();
+        let npairs = list.unique().len();
+        let full =
+            self.built != Some(list.builds) || self.overlap.len() != npairs || self.wall.len() != n;
+        self.selected.clear();
+        if full {
+            self.overlap.clear();
+            self.overlap.resize(npairs, f64::NEG_INFINITY);
+            self.wall.clear();
+            self.wall.resize(n, false);
+            self.selected.extend(0..npairs as u32);
+        } else {
+            self.pair_mark.clear();
+            self.pair_mark.resize(npairs, false);
+            for &i in &self.moved {
+                let first = list.entry_start(i as usize);
+                for k in first..first + list.of(i as usize).len() {
+                    self.pair_mark[list.pair_of_entry(k)] = true;
+                }
+            }
+            self.selected.extend(
+                self.pair_mark
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, m)| **m)
+                    .map(|(p, _)| p as u32),
+            );
+        }
+        let count = evaluate_pairs(state, list, &self.selected, &mut self.overlap);
+        // walls: every particle on a full scan, the moved ones otherwise
+        let mut walls = Vec::new();
+        let mut wall_of = |i: usize, wall: &mut Vec<bool>| {
+            walls.clear();
+            state.wall_contacts(i, 0.0, &mut walls);
+            wall[i] = walls.iter().any(|c| c.overlap > tol);
+        };
+        if full {
+            (0..n).for_each(|i| wall_of(i, &mut self.wall));
+        } else {
+            self.moved
+                .iter()
+                .for_each(|&i| wall_of(i as usize, &mut self.wall));
+        }
+        flags.clear();
+        flags.extend_from_slice(&self.wall);
+        for (p, o) in list.unique().iter().zip(&self.overlap) {
+            if *o > tol {
+                flags[p.i as usize] = true;
+                flags[p.j as usize] = true;
+            }
+        }
+        for &i in &self.moved {
+            self.moved_mark[i as usize] = false;
+        }
+        self.moved.clear();
+        self.built = Some(list.builds);
+        count
+    }
+}
+
+/// Evaluate the pairs `selected` (indices into [`NeighbourList::unique`]) in parallel, store
+/// their overlaps in `overlap` and their Newton starts in the list, in `selected` order.
+fn evaluate_pairs(
+    state: &PackingState,
+    list: &mut NeighbourList,
+    selected: &[u32],
+    overlap: &mut [f64],
+) -> ScanCount {
+    let l = &*list;
+    let results: Vec<(f64, bool, Option<WarmStart>)> = selected
+        .par_iter()
+        .with_min_len(SCAN_CHUNK)
+        .map(|&p| {
+            let e = l.unique()[p as usize];
+            let mut warm = l.warm(e.k as usize);
+            let c = state.contact_warm(e.i as usize, e.j as usize, e.shift(state.edges), &mut warm);
+            (c.overlap, c.fallback, warm)
+        })
+        .collect();
+    let mut count = ScanCount::default();
+    for (&p, (o, fallback, warm)) in selected.iter().zip(results) {
+        let k = list.unique()[p as usize].k as usize;
+        *list.warm_mut(k) = warm;
+        overlap[p as usize] = o;
+        count.contacts += 1;
+        count.fallbacks += fallback as u64;
+    }
+    count
+}
+
+/// The move of one particle computed from a fixed state: its new Newton starts (one per list
+/// entry of the particle, in entry order) and its displacement.
+#[derive(Debug, Clone, Default)]
+pub struct Proposal {
+    warm: Vec<Option<WarmStart>>,
+    displacement: Option<Displacement>,
+}
+
+/// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls
+/// into `out`, reading the cached Newton starts and writing the updated ones into `warm` (one
+/// per entry of i), without changing the list.
+pub fn contacts_of(
+    state: &PackingState,
+    list: &NeighbourList,
+    i: usize,
+    tol: f64,
+    out: &mut Vec<MoveContact>,
+    warm: &mut Vec<Option<WarmStart>>,
+) {
+    out.clear();
+    warm.clear();
+    let first = list.entry_start(i);
+    for k in first..first + list.of(i).len() {
+        let nb = list.entry(k);
+        let mut w = list.warm(k);
+        let c = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), &mut w);
+        warm.push(w);
+        if c.overlap > tol {
+            out.push(MoveContact::from(&c));
+        }
+    }
+    let mut walls = Vec::new();
+    state.wall_contacts(i, -tol, &mut walls);
+    out.extend(walls.iter().map(MoveContact::from));
+}
+
+/// The move of particle `i` under `rule` in the present state (see [`commit`]).
+pub fn propose(
+    state: &PackingState,
+    list: &NeighbourList,
+    i: usize,
+    rule: MoveRule,
+    tol: f64,
+    scratch: &mut Vec<MoveContact>,
+    rng: &mut impl Rng,
+) -> Proposal {
+    let mut p = Proposal::default();
+    contacts_of(state, list, i, tol, scratch, &mut p.warm);
+    p.displacement =
+        overlap_removal_move(rule, &state.bodies[i], state.orientations[i], scratch, rng);
+    p
+}
+
+/// Apply the proposal of particle `i`: store its Newton starts and move it. Returns whether it
+/// moved.
+pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &Proposal) -> bool {
+    let first = list.entry_start(i);
+    for (k, w) in p.warm.iter().enumerate() {
+        *list.warm_mut(first + k) = *w;
+    }
+    let Some(d) = p.displacement else {
+        return false;
+    };
+    let body = state.bodies[i];
+    state.positions[i] += d.dx;
+    state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
+    list.note_move(i, d.dx, turn_bound(&body, d.rotation));
+    true
+}
+
+/// Whether `rule` draws random numbers (then sweeps are serial).
+pub fn uses_rng(rule: MoveRule) -> bool {
+    matches!(
+        rule,
+        MoveRule::RevisedRandomRotation { .. } | MoveRule::RevisedRandomBoth { .. }
+    )
+}
+
+/// Counters of one sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SweepCount {
+    /// Moves made (attempts).
+    pub moves: u64,
+    /// Proposals recomputed because a neighbour had moved within the batch.
+    pub recomputed: u64,
+}
+
+/// Move the particles of `order` once each (those still overlapping), in that order, until
+/// `attempts` reaches `budget`; rebuilds the list when needed. `batch` = 1 is the serial
+/// sweep; larger batches propose moves in parallel with identical results (module header).
+#[allow(clippy::too_many_arguments)]
+pub fn sweep(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    tracker: &mut OverlapTracker,
+    order: &[usize],
+    rule: MoveRule,
+    tol: f64,
+    budget: u64,
+    attempts: &mut u64,
+    batch: usize,
+    rng: &mut impl Rng,
+) -> SweepCount {
+    let mut count = SweepCount::default();
+    let mut scratch = Vec::new();
+    if batch <= 1 || uses_rng(rule) {
+        for &i in order {
+            if *attempts >= budget {
+                break;
+            }
+            if list.needs_rebuild() {
+                list.build(state);
+            }
+            let p = propose(state, list, i, rule, tol, &mut scratch, rng);
+            if commit(state, list, i, &p) {
+                *attempts += 1;
+                count.moves += 1;
+                tracker.note_moved(i);
+            }
+        }
+        return count;
+    }
+    // the rules that run here draw no random numbers: this stream is never read
+    let mut no_rng = unused_rng();
+    let mut stamp = vec![0u32; state.len()];
+    let mut round = 0u32;
+    let mut pos = 0;
+    'batches: while pos < order.len() && *attempts < budget {
+        if list.needs_rebuild() {
+            list.build(state);
+        }
+        let end = (pos + batch).min(order.len());
+        let ids = &order[pos..end];
+        let (s, l) = (&*state, &*list);
+        let proposals: Vec<Proposal> = ids
+            .par_iter()
+            .with_max_len(1)
+            .map(|&i| propose(s, l, i, rule, tol, &mut Vec::new(), &mut unused_rng()))
+            .collect();
+        round += 1;
+        for (m, (&i, p)) in ids.iter().zip(&proposals).enumerate() {
+            if *attempts >= budget {
+                break 'batches;
+            }
+            if m > 0 && list.needs_rebuild() {
+                // the rebuild wraps the centres: the remaining proposals are stale
+                list.build(state);
+                pos += m;
+                continue 'batches;
+            }
+            let stale = list.of(i).iter().any(|nb| stamp[nb.j as usize] == round);
+            let moved = if stale {
+                count.recomputed += 1;
+                let fresh = propose(state, list, i, rule, tol, &mut scratch, &mut no_rng);
+                commit(state, list, i, &fresh)
+            } else {
+                commit(state, list, i, p)
+            };
+            if moved {
+                stamp[i] = round;
+                *attempts += 1;
+                count.moves += 1;
+                tracker.note_moved(i);
+            }
+        }
+        pos = end;
+    }
+    count
+}
+
+/// A random stream for the rules that draw no random numbers ([`uses_rng`] false): never read
+/// by them.
+fn unused_rng() -> Xoshiro256PlusPlus {
+    Xoshiro256PlusPlus::seed_from_u64(0)
+}
+
+/// The batch of [`sweep`] for the current rayon pool: 1 (serial) on one thread.
+pub fn batch_for_threads() -> usize {
+    let t = rayon::current_num_threads();
+    if t <= 1 { 1 } else { BATCH_PER_THREAD * t }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,205 @@
+use glam::DVec3;
+use magsep_components::packing::{OverlapRemovalScheme, PackingConfig};
+use magsep_components::shape::Shape;
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::*;
+use crate::packing::compress::{DriverParams, compress, run_to_end};
+use crate::packing::insert::random_insertion;
+use crate::packing::removal::{overlap_scan, remove_overlaps, remove_overlaps_batched};
+use crate::packing::state::Body;
+use crate::rng::particle_stream;
+
+const SUPERBALL: Shape = Shape::Superquadric {
+    semi_axes: DVec3::splat(0.5),
+    exponents: DVec3::splat(3.0),
+};
+
+/// `n` bodies of `shape` inserted at phi min(`phi`, 0.3) and compressed to `phi` (overlapping
+/// above 0.3).
+fn overlapping(shape: Shape, n: usize, phi: f64, seed: u64) -> (PackingState, NeighbourList) {
+    let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
+    let v: f64 = bodies.iter().map(|b| b.volume).sum();
+    let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
+    let mut state = random_insertion(
+        &bodies,
+        PackingState::periodic_cube((v / phi.min(0.3)).cbrt()),
+        &mut rngs,
+    )
+    .unwrap();
+    let mut list = NeighbourList::new(0.1);
+    list.build(&mut state);
+    if phi > 0.3 {
+        let dv = state.container_volume() - v / phi;
+        compress(&mut state, &mut list, dv);
+    }
+    list.ensure(&mut state);
+    (state, list)
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+}
+
+fn bits(s: &PackingState) -> Vec<u64> {
+    let mut v = vec![s.edges.x.to_bits()];
+    for (x, q) in s.positions.iter().zip(&s.orientations) {
+        v.extend(x.to_array().map(f64::to_bits));
+        v.extend(q.to_array().map(f64::to_bits));
+    }
+    v
+}
+
+#[test]
+fn tracked_flags_equal_the_full_serial_scan_after_moves() {
+    let tol = 1e-4;
+    let (mut state, mut list) = overlapping(SUPERBALL, 80, 0.5, 3);
+    let mut tracker = OverlapTracker::new();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+    let (mut flags, mut want) = (Vec::new(), Vec::new());
+    let mut partial_scans = 0;
+    for round in 0..6 {
+        list.ensure(&mut state);
+        let builds = list.builds;
+        let count = pool(2).install(|| tracker.scan(&state, &mut list, tol, &mut flags));
+        let mut reference = list.clone();
+        overlap_scan(&state, &mut reference, tol, &mut want);
+        assert_eq!(flags, want, "round {round}");
+        assert!(want.iter().any(|f| *f), "the configuration overlaps");
+        if round > 0 && list.builds == builds && count.contacts < list.unique().len() as u64 {
+            partial_scans += 1;
+        }
+        // move a few particles, as a sweep would
+        let order: Vec<usize> = (0..state.len()).filter(|i| flags[*i]).take(5).collect();
+        let mut attempts = 0;
+        let rule = MoveRule::Revised { dt: 0.1 };
+        sweep(
+            &mut state,
+            &mut list,
+            &mut tracker,
+            &order,
+            rule,
+            tol,
+            u64::MAX,
+            &mut attempts,
+            1,
+            &mut rng,
+        );
+        assert!(attempts > 0);
+    }
+    assert!(
+        partial_scans >= 3,
+        "only the moved particles' pairs are re-evaluated"
+    );
+}
+
+fn removal_bits(
+    shape: Shape,
+    rule: MoveRule,
+    threads: usize,
+    batch: usize,
+) -> (Vec<u64>, RemovalOutcome) {
+    let (mut state, mut list) = overlapping(shape, 60, 0.5, 5);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    let out = pool(threads).install(|| {
+        remove_overlaps_batched(&mut state, &mut list, rule, 1e-4, 200 * 60, batch, &mut rng)
+    });
+    (bits(&state), out)
+}
+
+use super::super::removal::RemovalOutcome;
+
+#[test]
+fn batched_sweeps_are_the_serial_sweep_bit_for_bit() {
+    let rod = Shape::Spherocylinder {
+        radius: 0.5,
+        half_length: 1.0,
+    };
+    for (shape, rule) in [
+        (SUPERBALL, MoveRule::Revised { dt: 0.1 }),
+        (
+            rod,
+            MoveRule::Original {
+                beta: 0.5,
+                xi: None,
+            },
+        ),
+    ] {
+        let (serial, out) = removal_bits(shape, rule, 1, 1);
+        assert!(out.attempts > 100, "{out:?}");
+        for (threads, batch) in [(1, 8), (2, 2), (2, 8), (2, 64)] {
+            let (got, o) = removal_bits(shape, rule, threads, batch);
+            assert_eq!(o, out, "{shape:?} threads {threads} batch {batch}");
+            assert!(got == serial, "{shape:?} threads {threads} batch {batch}");
+        }
+    }
+}
+
+#[test]
+fn superball_packing_is_the_same_on_one_and_two_threads() {
+    let n = 40;
+    let mut cfg = PackingConfig::defaults_for(n, 1.0);
+    cfg.scheme = OverlapRemovalScheme::Revised;
+    cfg.max_attempts = PackingConfig::default_max_attempts(cfg.scheme, n);
+    cfg.max_compression_steps = 120;
+    let p = DriverParams::from_config(&cfg, 1.0);
+    let run = |threads: usize| {
+        let (mut state, mut list) = overlapping(SUPERBALL, n, 0.1, 7);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(13);
+        let st = pool(threads).install(|| {
+            assert_eq!(batch_for_threads(), if threads == 1 { 1 } else { 8 });
+            run_to_end(&p, &mut state, &mut list, &mut rng, |_| {})
+        });
+        (bits(&state), st)
+    };
+    let (one, st1) = run(1);
+    let (two, st2) = run(2);
+    assert!(st1.attempts > 1000 && st1.packing_fraction > 0.3, "{st1:?}");
+    assert_eq!(st1, st2);
+    assert!(one == two, "final states differ");
+}
+
+#[test]
+fn remove_overlaps_uses_the_pool_and_keeps_the_serial_result() {
+    let (mut a, mut la) = overlapping(SUPERBALL, 50, 0.45, 2);
+    let (mut b, mut lb) = (a.clone(), la.clone());
+    let rule = MoveRule::Revised { dt: 0.1 };
+    let mut ra = Xoshiro256PlusPlus::seed_from_u64(1);
+    let mut rb = ra.clone();
+    let oa = pool(1).install(|| remove_overlaps(&mut a, &mut la, rule, 1e-4, 10_000, &mut ra));
+    let ob = pool(2).install(|| remove_overlaps(&mut b, &mut lb, rule, 1e-4, 10_000, &mut rb));
+    assert_eq!(oa, ob);
+    assert!(bits(&a) == bits(&b));
+    assert!(oa.attempts > 1000, "{oa:?}");
+}
+
+#[test]
+#[ignore = "timing (release): 750 superballs, 300 compression steps on 1 and 2 threads"]
+fn superballs_750_steps_on_one_and_two_threads() {
+    let n = 750;
+    let mut cfg = PackingConfig::defaults_for(n, 1.0);
+    cfg.scheme = OverlapRemovalScheme::Revised;
+    cfg.max_attempts = PackingConfig::default_max_attempts(cfg.scheme, n);
+    cfg.max_compression_steps = 300;
+    let p = DriverParams::from_config(&cfg, 1.0);
+    let run = |threads: usize| {
+        let (mut state, mut list) = overlapping(SUPERBALL, n, 0.05, 1);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        let t = std::time::Instant::now();
+        let st = pool(threads).install(|| run_to_end(&p, &mut state, &mut list, &mut rng, |_| {}));
+        let s = t.elapsed().as_secs_f64();
+        eprintln!(
+            "threads {threads}: {s:.2} s, phi {:.4}, attempts {}, contacts {}",
+            st.packing_fraction, st.attempts, st.contact_evaluations
+        );
+        (bits(&state), st)
+    };
+    let (one, st1) = run(1);
+    let (two, st2) = run(2);
+    assert_eq!(st1, st2);
+    assert!(one == two);
+}
