@@ -153,6 +153,7 @@ pub fn method_name(m: MobilityMethod) -> &'static str {
         MobilityMethod::Cholesky => "cholesky",
         MobilityMethod::Tea => "tea",
         MobilityMethod::Krylov => "krylov",
+        MobilityMethod::SpectralEwald => "spectral_ewald",
     }
 }
 
