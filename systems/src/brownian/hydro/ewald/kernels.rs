@@ -82,6 +82,7 @@ pub(crate) fn smoothed_laplacian(r: f64, alpha: f64) -> (f64, f64) {
 }
 
 /// (A, B) of the Hasimoto real-space remainder of the Stokeslet at `r` > 0 (ξ = 0: S itself).
+#[cfg(test)]
 pub(crate) fn real_stokeslet(r: f64, xi: f64) -> (f64, f64) {
     let x = xi * r;
     let c = erfc(x) / r;
@@ -90,6 +91,7 @@ pub(crate) fn real_stokeslet(r: f64, xi: f64) -> (f64, f64) {
 }
 
 /// (A, B) of the real-space remainder of the Laplacian at `r` > 0 (ξ = 0: L itself).
+#[cfg(test)]
 pub(crate) fn real_laplacian(r: f64, xi: f64) -> (f64, f64) {
     let x = xi * r;
     let r2 = r * r;
@@ -111,6 +113,25 @@ pub(crate) fn wave_stokeslet(r: f64, alpha: f64, xi: f64) -> (f64, f64) {
     let (la, lb) = smoothed_laplacian(r, alpha);
     let q = 1.0 / (4.0 * xi * xi);
     (sa - q * la, sb - q * lb)
+}
+
+/// (A, B) of the real-space RPY remainder S_R + (s/6) L_R at `r` > 0, s = a_i² + a_j²
+/// (one erfc and one exponential for both kernels).
+pub(crate) fn real_rpy(r: f64, xi: f64, s: f64) -> (f64, f64) {
+    let x = xi * r;
+    let c1 = erfc(x) / r;
+    let ex = (-x * x).exp();
+    let g = 2.0 * xi * ex / SQRT_PI;
+    let r2 = r * r;
+    let c3 = c1 / r2;
+    let gl = ex * xi / SQRT_PI;
+    let t2 = gl / r2;
+    let t0 = gl * xi * xi;
+    let q = s / 6.0;
+    (
+        c1 - g + q * (2.0 * c3 + 4.0 * t2 + 8.0 * t0),
+        c1 + g - q * (6.0 * c3 + 12.0 * t2 + 8.0 * t0),
+    )
 }
 
 /// Far-field (non-overlapping) RPY pair tensor in units of 1/(8πη):

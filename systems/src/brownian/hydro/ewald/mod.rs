@@ -86,11 +86,17 @@ impl SpectralEwald {
         tolerance: f64,
     ) -> Result<Self, HydroError> {
         check_tolerance(tolerance)?;
-        let params = Params::choose(tolerance, positions, radii, PRODUCTS_PER_STEP);
+        let params = Params::choose(tolerance, positions, radii, PRODUCTS_PER_STEP).ok_or(
+            HydroError::InvalidInput(
+                "configuration too spread out for the spectral Ewald grid and too large for \
+                 the direct sum",
+            ),
+        )?;
         Ok(Self::with_params(params, positions, radii, viscosity))
     }
 
     /// As [`SpectralEwald::new`] with an explicit real-space cut-off \[m\] (`None`: direct sum).
+    #[cfg(test)]
     pub fn with_cutoff(
         positions: &[DVec3],
         radii: &[f64],

@@ -11,7 +11,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::kernels::{far_rpy, real_laplacian, real_stokeslet, smoothed_laplacian, wave_stokeslet};
+use super::kernels::{far_rpy, real_rpy, smoothed_laplacian, wave_stokeslet};
 use super::params::Params;
 use crate::brownian::cells::CellList;
 use crate::brownian::hydro::rpy::{rpy_coefficients, self_mobility};
@@ -38,9 +38,8 @@ fn pair(r: f64, a_i: f64, a_j: f64, viscosity: f64, xi: f64) -> (f64, f64) {
             let (a, b) = far_rpy(r, s);
             return (pre * a, pre * b);
         }
-        let (sa, sb) = real_stokeslet(r, xi);
-        let (la, lb) = real_laplacian(r, xi);
-        (pre * (sa + s / 6.0 * la), pre * (sb + s / 6.0 * lb))
+        let (a, b) = real_rpy(r, xi, s);
+        (pre * a, pre * b)
     } else {
         let (za, zb) = rpy_coefficients(r * r, a_i, a_j, viscosity);
         if xi == 0.0 {

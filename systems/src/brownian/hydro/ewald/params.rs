@@ -24,6 +24,12 @@ use glam::DVec3;
 /// Gaussian split between spreading/gathering and the middle kernel.
 pub(crate) const SPLIT: f64 = 0.6;
 
+/// Largest FFT length per side (memory: about 100 n³ bytes while preparing the kernel).
+pub const MAX_FFT: usize = 320;
+
+/// Largest number of stored pair blocks (40 bytes each).
+pub const MAX_PAIR_BLOCKS: f64 = 5e7;
+
 /// Smallest accepted tolerance (below it rounding in the FFTs dominates).
 pub const MIN_TOLERANCE: f64 = 1e-12;
 /// Largest accepted tolerance.
@@ -141,9 +147,22 @@ impl Params {
         self.xi == 0.0
     }
 
-    /// Parameters minimising the cost model over cut-offs r_c = 2 max(a) · 1.25^k.
+    /// True if the grid and the pair list fit the memory limits ([`MAX_FFT`],
+    /// [`MAX_PAIR_BLOCKS`]) for `pairs` estimated pair blocks.
+    fn fits(&self, pairs: f64) -> bool {
+        self.fft_n <= MAX_FFT && pairs <= MAX_PAIR_BLOCKS
+    }
+
+    /// Parameters minimising the cost model over cut-offs r_c = 2 max(a) · 1.25^k (k ≥ 2) among those
+    /// that fit the memory limits; `None` when none does (a configuration far too spread out
+    /// for one grid and too large for the direct sum).
     /// `products` is the expected number of products per prepared configuration.
-    pub fn choose(tolerance: f64, positions: &[DVec3], radii: &[f64], products: f64) -> Self {
+    pub fn choose(
+        tolerance: f64,
+        positions: &[DVec3],
+        radii: &[f64],
+        products: f64,
+    ) -> Option<Self> {
         let n = positions.len() as f64;
         let (lo, hi) = bounds(positions);
         let a_max = radii.iter().fold(0.0_f64, |m, a| m.max(*a));
@@ -155,34 +174,42 @@ impl Params {
             (hi - lo).max(DVec3::splat(2.0 * a_max)).element_product()
         };
         let density = n / volume;
-        // nanoseconds: pair set-up (erfc, exp, 3×3 block), pair product, FFT per n log2 n,
-        // kernel sampling per grid point, spreading per particle per support point
-        let (pair_setup, pair_apply, fft_unit, sample, spread) = (60.0, 4.0, 1.0, 40.0, 3.0);
+        // nanoseconds (2-core development machine): pair set-up with erfc/exp, without (direct
+        // sum), pair product, FFT per point·log2(points) and field, spreading+gathering per
+        // particle, support point and field. The kernel's transform is cached across steps.
+        let (pair_setup, direct_setup, pair_apply, fft_unit, spread) = (150.0, 40.0, 8.0, 1.0, 1.0);
         let cost_of = |p: &Params| -> f64 {
             if p.is_direct() {
-                return n * n * (pair_setup + products * pair_apply);
+                return n * n * (direct_setup + products * pair_apply);
             }
             let pairs =
                 (n * density * 4.0 / 3.0 * std::f64::consts::PI * p.cutoff.powi(3)).min(n * n);
             let g = (p.fft_n as f64).powi(3);
-            let fft = fft_unit * g * g.log2();
-            let prep = pairs * pair_setup + 2.0 * g * sample + fields * fft;
             let per = pairs * pair_apply
-                + 0.6 * fields * fft
-                + 2.0 * n * (p.support as f64).powi(3) * spread * fields / 6.0;
-            prep + products * per
+                + 0.6 * fields * fft_unit * g * g.log2()
+                + 2.0 * n * (p.support as f64).powi(3) * spread * fields / 2.0;
+            pairs * pair_setup + products * per
         };
-        let mut best = Self::with_cutoff(tolerance, None, positions, radii);
-        let mut best_cost = cost_of(&best);
-        let mut rc = 2.0 * a_max;
-        for _ in 0..40 {
+        let pairs_of = |p: &Params| {
+            if p.is_direct() {
+                n * n
+            } else {
+                (n * density * 4.0 / 3.0 * std::f64::consts::PI * p.cutoff.powi(3)).min(n * n)
+            }
+        };
+        let direct = Self::with_cutoff(tolerance, None, positions, radii);
+        let mut best = direct.fits(pairs_of(&direct)).then_some(direct);
+        let mut best_cost = best.as_ref().map_or(f64::INFINITY, &cost_of);
+        // the ladder starts at 2 max(a)·1.25² (smaller cut-offs need very fine grids)
+        let mut rc = 2.0 * a_max * 1.25 * 1.25;
+        for _ in 0..60 {
             let p = Self::with_cutoff(tolerance, Some(rc), positions, radii);
             if p.is_direct() {
                 break;
             }
             let c = cost_of(&p);
-            if c < best_cost {
-                best = p;
+            if p.fits(pairs_of(&p)) && c < best_cost {
+                best = Some(p);
                 best_cost = c;
             }
             rc *= 1.25;

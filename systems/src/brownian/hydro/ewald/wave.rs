@@ -18,6 +18,8 @@ use rayon::prelude::*;
 use realfft::num_complex::Complex64;
 use std::f64::consts::PI;
 
+use std::sync::{Arc, Mutex};
+
 use super::fft3::Fft3;
 use super::kernels::{smoothed_laplacian, wave_stokeslet};
 use super::params::{Params, SPLIT};
@@ -38,11 +40,26 @@ pub(crate) struct Wave {
     /// per x-plane: the particles whose support covers it, increasing index
     plane_members: Vec<Vec<u32>>,
     /// Stokeslet kernel (or the combined S̃ + a²/3 L̃ for equal radii), scaled
-    kernel_s: Vec<Sym>,
+    kernel_s: Arc<Vec<Sym>>,
     /// Laplacian kernel for unequal radii, scaled
-    kernel_l: Option<Vec<Sym>>,
+    kernel_l: Option<Arc<Vec<Sym>>>,
     radii_sq: Vec<f64>,
 }
+
+/// The kernel spectra of one grid: Stokeslet (or combined) and, for unequal radii, Laplacian.
+type Spectra = (Arc<Vec<Sym>>, Option<Arc<Vec<Sym>>>);
+
+/// Cache key: FFT length and the bits of h, ξ, α, the prefactor and the common a² (NaN bits for
+/// unequal radii).
+type Key = (usize, [u64; 5]);
+
+/// The most recent kernel spectra (a step rebuilds the mobility at a configuration whose grid
+/// parameters rarely change). Recomputing gives bitwise the same values, so the cache cannot
+/// change results.
+static CACHE: Mutex<Vec<(Key, Spectra)>> = Mutex::new(Vec::new());
+
+/// Entries kept in [`CACHE`].
+const CACHE_ENTRIES: usize = 3;
 
 /// Sampled kernel DFT (real part) in T layout, scaled by `scale`.
 fn kernel_spectrum(
@@ -52,15 +69,13 @@ fn kernel_spectrum(
     eval: &(dyn Fn(f64) -> (f64, f64) + Sync),
 ) -> Vec<Sym> {
     let n = fft.n;
-    let m = fft.m;
-    // displacement index: 0..m−1 and n−m+1..n−1 ↦ −(m−1)..−1; others unused (zero)
+    // displacement index i ↦ i for i ≤ n/2, i − n above. Only |d| < m is ever used by the
+    // convolution (n ≥ 2m), so the kernel does not depend on m and can be cached by n.
     let disp = |i: usize| -> Option<f64> {
-        if i < m {
+        if i <= n / 2 {
             Some(i as f64)
-        } else if i > n - m {
-            Some(i as f64 - n as f64)
         } else {
-            None
+            Some(i as f64 - n as f64)
         }
     };
     let mut samples = vec![0.0; n * n * n * 6];
@@ -143,19 +158,46 @@ impl Wave {
         let h3 = h * h * h;
         let scale = prefactor * h3 * h3 / (n as f64).powi(3);
         let alpha = params.alpha;
-        let (kernel_s, kernel_l) = if mono {
-            let a2 = radii.first().map_or(0.0, |a| a * a);
-            let k = kernel_spectrum(&fft, h, scale, &|r| {
-                let (sa, sb) = wave_stokeslet(r, alpha, xi);
-                let (la, lb) = smoothed_laplacian(r, alpha);
-                (sa + a2 / 3.0 * la, sb + a2 / 3.0 * lb)
-            });
-            (k, None)
+        let a2 = if mono {
+            radii.first().map_or(0.0, |a| a * a)
         } else {
-            let ks = kernel_spectrum(&fft, h, scale, &|r| wave_stokeslet(r, alpha, xi));
-            let kl = kernel_spectrum(&fft, h, scale / 6.0, &|r| smoothed_laplacian(r, alpha));
-            (ks, Some(kl))
+            f64::NAN
         };
+        let key = (
+            n,
+            [
+                h.to_bits(),
+                xi.to_bits(),
+                alpha.to_bits(),
+                prefactor.to_bits(),
+                a2.to_bits(),
+            ],
+        );
+        let cached = CACHE
+            .lock()
+            .ok()
+            .and_then(|c| c.iter().find(|(k, _)| *k == key).map(|(_, v)| v.clone()));
+        let (kernel_s, kernel_l) = cached.unwrap_or_else(|| {
+            let spectra: Spectra = if mono {
+                let k = kernel_spectrum(&fft, h, scale, &|r| {
+                    let (sa, sb) = wave_stokeslet(r, alpha, xi);
+                    let (la, lb) = smoothed_laplacian(r, alpha);
+                    (sa + a2 / 3.0 * la, sb + a2 / 3.0 * lb)
+                });
+                (Arc::new(k), None)
+            } else {
+                let ks = kernel_spectrum(&fft, h, scale, &|r| wave_stokeslet(r, alpha, xi));
+                let kl = kernel_spectrum(&fft, h, scale / 6.0, &|r| smoothed_laplacian(r, alpha));
+                (Arc::new(ks), Some(Arc::new(kl)))
+            };
+            if let Ok(mut c) = CACHE.lock() {
+                if c.len() >= CACHE_ENTRIES {
+                    c.remove(0);
+                }
+                c.push((key, spectra.clone()));
+            }
+            spectra
+        });
         Self {
             fft,
             support: p,
