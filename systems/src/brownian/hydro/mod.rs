@@ -137,7 +137,7 @@ enum Inner {
     Cholesky { m: DenseSym, l: faer::Mat<f64> },
     Tea { m: DenseSym, tea: tea::Tea },
     Krylov { m: DenseSym },
-    SpectralEwald { op: ewald::SpectralEwald },
+    SpectralEwald { op: Box<ewald::SpectralEwald> },
 }
 
 /// The mobility prepared at one configuration.
@@ -232,12 +232,12 @@ impl Mobility {
                 m: DenseSym::rpy(positions, radii, viscosity),
             },
             MobilityMethod::SpectralEwald => Inner::SpectralEwald {
-                op: ewald::SpectralEwald::new(
+                op: Box::new(ewald::SpectralEwald::new(
                     positions,
                     radii,
                     viscosity,
                     options.ewald_tolerance,
-                )?,
+                )?),
             },
         };
         Ok(Self {

@@ -29,6 +29,9 @@ pub(crate) struct Near {
     diag: Vec<f64>,
 }
 
+/// One row of the pair list: columns and blocks.
+type Row = (Vec<u32>, Vec<(f64, f64, DVec3)>);
+
 /// (iso, dyad) in SI of the pair block of particles at separation r with radii a_i, a_j.
 fn pair(r: f64, a_i: f64, a_j: f64, viscosity: f64, xi: f64) -> (f64, f64) {
     let pre = 1.0 / (8.0 * PI * viscosity);
@@ -61,7 +64,7 @@ impl Near {
         let xi = params.xi;
         let cells =
             (!params.is_direct()).then(|| CellList::build(positions, params.cutoff, |_| true));
-        let rows: Vec<(Vec<u32>, Vec<(f64, f64, DVec3)>)> = (0..n)
+        let rows: Vec<Row> = (0..n)
             .into_par_iter()
             .with_min_len(ROWS)
             .map(|i| {
