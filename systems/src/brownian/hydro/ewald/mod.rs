@@ -15,12 +15,12 @@
 //!   −2∇∇(erfc(ξr)/r) + 8πG_ξ I (L = −2∇∇(1/r) − 8πδI is harmonic away from 0, so the Gaussian
 //!   split leaves an exponentially decaying remainder);
 //!
-//! (closed forms in [`kernels`]). The real parts are summed over pairs closer than r_c
-//! ([`near`], cell list); overlapping pairs r ≤ a_i + a_j get the exact Zuk overlap block
+//! (closed forms in `kernels`). The real parts are summed over pairs closer than r_c
+//! (`near`, cell list); overlapping pairs r ≤ a_i + a_j get the exact Zuk overlap block
 //! minus the wave part added by the grid; the self block is I/(6πηa_i) minus the grid's
-//! self-interaction. The wave parts are computed on a grid ([`wave`]): Gaussian spreading of
+//! self-interaction. The wave parts are computed on a grid (`wave`): Gaussian spreading of
 //! f and a²f (P³ points each), an aperiodic convolution with the smooth middle kernel
-//! sampled in real space and transformed by zero-padded FFTs ([`fft3`]), and Gaussian gathering.
+//! sampled in real space and transformed by zero-padded FFTs (`fft3`), and Gaussian gathering.
 //!
 //! # Free space
 //! Spectral Ewald is usually periodic. Here the middle kernel carries part of the Gaussian,
