@@ -104,6 +104,11 @@ pub struct CaptureEvent {
     pub fibre: u64,
 }
 
+/// Default of [`BrownianConfig::ewald_tolerance`].
+fn default_ewald_tolerance() -> f64 {
+    1e-6
+}
+
 /// Mobility choice of the scene (`mobility = "auto"`, ...).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
@@ -119,6 +124,9 @@ pub enum MobilityChoice {
     Tea,
     /// Rotne-Prager-Yamakawa with Krylov (Lanczos) square-root displacements.
     Krylov,
+    /// Rotne-Prager-Yamakawa without a matrix: free-space spectral Ewald products (relative
+    /// accuracy `ewald_tolerance`), Krylov square-root displacements; O(N log N) per product.
+    SpectralEwald,
 }
 
 /// Time stepping of the Ermak-McCammon update.
@@ -224,6 +232,9 @@ pub struct BrownianConfig {
     pub mobility: MobilityChoice,
     /// Relative tolerance of the Krylov square root. Default 1e-6.
     pub krylov_tolerance: f64,
+    /// Relative accuracy of the spectral Ewald mobility product. Default 1e-6.
+    #[serde(default = "default_ewald_tolerance")]
+    pub ewald_tolerance: f64,
     /// Time stepping.
     pub step_control: StepControl,
     /// Excluded volume.

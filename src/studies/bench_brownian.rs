@@ -27,7 +27,10 @@ use serde_json::{Value, json};
 use crate::studies::bench::{BenchError, emit, log_slope};
 
 pub use cost::{CostChartSizes, CostPoint, cost_points};
-pub use hi::{MobilityStepTime, random_configuration, time_mobility_step};
+pub use hi::{
+    MobilityStepTime, product_error, random_configuration, time_mobility_step,
+    time_mobility_step_with,
+};
 pub use lammps_case::lammps_mirror_scene;
 pub use pipeline::{PipelineRate, free_draining_scene, mean_neighbours, pipeline_rate};
 
@@ -47,6 +50,10 @@ pub const DIPOLE_CUTOFF: f64 = 30.0;
 pub const TIME_STEP: f64 = 1e-6;
 /// Krylov tolerance of the HI cost benchmark (the scene default).
 pub const KRYLOV_TOLERANCE: f64 = 1e-6;
+/// Product tolerance of the spectral Ewald rows.
+pub const SPECTRAL_EWALD_TOLERANCE: f64 = 1e-4;
+/// Krylov tolerance of the spectral Ewald rows (covariance accuracy of order 1e-3).
+pub const SPECTRAL_KRYLOV_TOLERANCE: f64 = 1e-3;
 /// LAMMPS's Brownian integrator with dipoles, particle-steps per second per core (the goal
 /// figure the pipeline rate is compared with).
 pub const LAMMPS_REFERENCE_PER_CORE: f64 = 1.1e6;
@@ -94,6 +101,8 @@ pub struct BrownianBenchSizes {
     pub hi_sizes: Vec<usize>,
     /// Mobility methods of the HI cost benchmark.
     pub hi_methods: Vec<MobilityMethod>,
+    /// Particle numbers of the spectral Ewald rows (each at every thread count).
+    pub spectral_sizes: Vec<usize>,
     /// Lattice cells per side of the LAMMPS-mirror case (`ncell³` particles; 0: not run).
     pub mirror_ncell: usize,
 }
@@ -112,6 +121,7 @@ impl BrownianBenchSizes {
                 MobilityMethod::Tea,
                 MobilityMethod::Krylov,
             ],
+            spectral_sizes: vec![1000, 10_000],
             mirror_ncell: 22,
         }
     }
@@ -123,6 +133,7 @@ impl BrownianBenchSizes {
             warmup_steps: 2,
             pipeline_seconds: 0.5,
             hi_sizes: vec![100, 300],
+            spectral_sizes: vec![300],
             ..Self::full()
         }
     }
@@ -153,6 +164,7 @@ pub fn method_name(m: MobilityMethod) -> &'static str {
         MobilityMethod::Cholesky => "cholesky",
         MobilityMethod::Tea => "tea",
         MobilityMethod::Krylov => "krylov",
+        MobilityMethod::SpectralEwald => "spectral_ewald",
     }
 }
 
@@ -284,7 +296,65 @@ pub fn bench_brownian_with(
             )?;
         }
     }
+    spectral_rows(sizes, as_json, &mut rows)?;
     Ok(rows)
+}
+
+/// (c) the matrix-free spectral Ewald mobility at [`SPECTRAL_EWALD_TOLERANCE`] and
+/// [`SPECTRAL_KRYLOV_TOLERANCE`], at every size and thread count, with its product error
+/// against the direct RPY sum.
+fn spectral_rows(
+    sizes: &BrownianBenchSizes,
+    as_json: bool,
+    rows: &mut Vec<Value>,
+) -> Result<(), BenchError> {
+    use magsep_systems::brownian::hydro::MobilityOptions;
+    let options = MobilityOptions {
+        krylov_tolerance: SPECTRAL_KRYLOV_TOLERANCE,
+        ewald_tolerance: SPECTRAL_EWALD_TOLERANCE,
+        ..MobilityOptions::default()
+    };
+    let method = MobilityMethod::SpectralEwald;
+    for &hn in &sizes.spectral_sizes {
+        let x = random_configuration(hn, RADIUS, HI_VOLUME_FRACTION, 7 + hn as u64);
+        let radii = vec![RADIUS; hn];
+        let error = product_error(method, &x, &radii, VISCOSITY, options)?;
+        for &threads in &sizes.threads {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| BenchError::Runtime(format!("thread pool: {e}")))?;
+            let t = pool.install(|| {
+                time_mobility_step_with(method, &x, &radii, VISCOSITY, options, hi_reps(hn))
+            })?;
+            emit(
+                rows,
+                as_json,
+                json!({
+                    "name": "brownian_hi_spectral_ewald",
+                    "bench": "brownian",
+                    "case": "hi_spectral",
+                    "method": method_name(method),
+                    "n": hn,
+                    "threads": threads,
+                    "volume_fraction": HI_VOLUME_FRACTION,
+                    "ewald_tolerance": SPECTRAL_EWALD_TOLERANCE,
+                    "krylov_tolerance": SPECTRAL_KRYLOV_TOLERANCE,
+                    "product_error": error,
+                    "ewald": t.ewald,
+                    "repetitions": hi_reps(hn),
+                    "prepare_s": t.prepare_s,
+                    "noise_s": t.noise_s,
+                    "apply_s": t.apply_s,
+                    "s_per_step": t.total_s,
+                    "steps_per_s": 1.0 / t.total_s,
+                    "krylov_iterations": t.krylov_iterations,
+                    "load_average_1min": load_average(),
+                }),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// The LAMMPS-mirror rows (the configuration of anchor-bench `lammps_bd.sh`, see

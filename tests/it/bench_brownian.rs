@@ -28,6 +28,7 @@ fn bench_rows_are_well_formed_with_positive_rates() {
             MobilityMethod::Tea,
             MobilityMethod::Krylov,
         ],
+        spectral_sizes: vec![60],
         mirror_ncell: 4,
     };
     let rows = bench_brownian_with(&sizes, true).unwrap();
@@ -79,6 +80,14 @@ fn bench_rows_are_well_formed_with_positive_rates() {
         positive(r, "s_per_step");
         positive(r, "steps_per_s");
     }
+    let spectral = case("hi_spectral");
+    assert_eq!(spectral.len(), 2, "1 and 2 threads");
+    for r in &spectral {
+        positive(r, "steps_per_s");
+        assert_eq!(r["n"], 60);
+        let e = r["product_error"].as_f64().unwrap();
+        assert!(e <= r["ewald_tolerance"].as_f64().unwrap(), "{r}");
+    }
     let ex = case("hi_exponent");
     assert_eq!(ex.len(), 3);
     for r in &ex {
@@ -99,14 +108,15 @@ fn cost_chart_writes_svg_and_data() {
     let svg = std::fs::read_to_string(dir.join("brownian_mobility_cost.svg")).unwrap();
     assert!(svg.trim_start().starts_with("<svg") || svg.trim_start().starts_with("<?xml"));
     assert!(svg.trim_end().ends_with("</svg>"));
-    assert!(svg.contains("Krylov"));
+    assert!(svg.contains("Krylov") && svg.contains("spectral Ewald"));
     let data: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.join("brownian_mobility_cost.json")).unwrap(),
     )
     .unwrap();
     let pts = data["points"].as_array().unwrap();
-    // 2 fractions x 2 sizes x (free draining, Cholesky, TEA, 2 Krylov tolerances)
-    assert_eq!(pts.len(), 20);
+    // 2 fractions x 2 sizes x (free draining, Cholesky, TEA, 2 Krylov and 2 spectral Ewald
+    // tolerances)
+    assert_eq!(pts.len(), 28);
     for p in pts {
         assert!(p["cost_s"].as_f64().unwrap() > 0.0, "{p}");
         let e = p["error"].as_f64().unwrap();
@@ -117,8 +127,11 @@ fn cost_chart_writes_svg_and_data() {
         if p["method"] == "free_draining" {
             assert!(e > 1e-4, "{p}");
         }
+        if p["method"] == "spectral_ewald" && p["tolerance"].as_f64().unwrap() <= 1e-6 {
+            assert!(e < 1e-4, "{p}");
+        }
     }
-    assert_eq!(summary["points"].as_array().unwrap().len(), 20);
+    assert_eq!(summary["points"].as_array().unwrap().len(), 28);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -49,6 +49,7 @@ fn world(n: u64, dt: f64, steps: u64, control: StepControl) -> SimApp {
         steps,
         mobility: MobilityChoice::FreeDraining,
         krylov_tolerance: 1e-6,
+        ewald_tolerance: 1e-6,
         step_control: control,
         contact: ContactModel::None,
         dipole_cutoff: None,

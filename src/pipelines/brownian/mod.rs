@@ -49,6 +49,8 @@ impl Pipeline for BrownianPipeline {
         let hydro = match section.mobility.unwrap_or_default() {
             MobilityChoice::FreeDraining => 0.0,
             MobilityChoice::Cholesky => 2.0 * dense,
+            // pair blocks (~100 per particle at 40 B) and at most a 320³ grid of six fields
+            MobilityChoice::SpectralEwald => 4096.0 * n + 6.0 * 16.0 * 320f64.powi(3) / 2.0,
             _ => dense,
         };
         // replicates run in parallel, one world each

@@ -12,7 +12,8 @@
 //! runs = 30                 # independent replicates, run in parallel
 //! temperature = 298.0       # [K]
 //! viscosity = 1.0e-3        # [Pa s]
-//! mobility = "auto"         # free_draining | cholesky | tea | krylov | auto
+//! mobility = "auto"         # free_draining | cholesky | tea | krylov | spectral_ewald | auto
+//! ewald_tolerance = 1e-6    # relative accuracy of the spectral_ewald product, [1e-12, 0.1]
 //! step_control = { kind = "adaptive", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }
 //! contact = { kind = "mie", epsilon_kt = 100.0, n = 30.0, m = 15.0 }   # or hard_core, none
 //! dipole_cutoff = 30.0      # in mean radii of the pair; 0 switches dipole forces off
@@ -75,6 +76,10 @@ pub struct BrownianSection {
     /// Krylov tolerance. Default 1e-6. Range (0, 0.1].
     #[serde(default)]
     pub krylov_tolerance: Option<f64>,
+    /// Relative accuracy of the `spectral_ewald` mobility product. Default 1e-6.
+    /// Range [1e-12, 0.1].
+    #[serde(default)]
+    pub ewald_tolerance: Option<f64>,
     /// Time stepping. Default adaptive (tolerance 1e-2, max_displacement 0.5, max_depth 24).
     #[serde(default)]
     pub step_control: Option<StepControl>,
@@ -110,6 +115,7 @@ impl BrownianSection {
             steps,
             mobility: self.mobility.unwrap_or_default(),
             krylov_tolerance: self.krylov_tolerance.unwrap_or(1e-6),
+            ewald_tolerance: self.ewald_tolerance.unwrap_or(1e-6),
             step_control: self.step_control.unwrap_or_default(),
             contact: self.contact.unwrap_or_default(),
             dipole_cutoff: match self.dipole_cutoff {
@@ -187,6 +193,14 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
         errors.push(SceneError::new(
             "brownian.krylov_tolerance",
             format!("must be in (0, 0.1], got {t}"),
+        ));
+    }
+    if let Some(t) = b.ewald_tolerance
+        && !(t.is_finite() && (1e-12..=0.1).contains(&t))
+    {
+        errors.push(SceneError::new(
+            "brownian.ewald_tolerance",
+            format!("must be in [1e-12, 0.1], got {t}"),
         ));
     }
     if let Some((tolerance, max_displacement, max_depth)) =

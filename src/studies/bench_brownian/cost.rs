@@ -1,7 +1,10 @@
 //! The mobility cost/accuracy chart: for each method, the relative error of the Brownian
 //! displacement covariance ‖B Bᵀ − μ‖_F / ‖μ‖_F against the exact RPY mobility
 //! (`covariance_error`) and the wall time of one step's stochastic work (prepare + one noise
-//! draw), on random configurations at two volume fractions.
+//! draw), on random configurations at two volume fractions. Krylov and the matrix-free
+//! spectral Ewald mobility are drawn at each of the tolerances (for spectral Ewald the product
+//! and the Krylov tolerance are both set to it; at these small N its cost model may pick the
+//! direct pair sum, recorded as `ewald_grid` = 0 in the JSON data).
 
 use std::path::Path;
 use std::time::Instant;
@@ -61,7 +64,7 @@ pub struct CostPoint {
     pub volume_fraction: f64,
     /// Particles.
     pub n: usize,
-    /// `free_draining`, `cholesky`, `tea` or `krylov`.
+    /// `free_draining`, `cholesky`, `tea`, `krylov` or `spectral_ewald`.
     pub method: String,
     /// Krylov tolerance (None for the other methods).
     pub tolerance: Option<f64>,
@@ -73,6 +76,8 @@ pub struct CostPoint {
     pub plotted_error: f64,
     /// Krylov iterations of one noise draw.
     pub krylov_iterations: usize,
+    /// Spectral Ewald FFT length per side (0: direct sum or another method).
+    pub ewald_grid: usize,
 }
 
 /// Mean cost [s] of prepare + one noise draw (repeated for `min_time`), the covariance
@@ -85,9 +90,10 @@ fn measure(
     w: &[glam::DVec3],
     error_of: &dyn Fn(&Mobility) -> Result<f64, HydroError>,
     min_time: f64,
-) -> Result<(f64, f64, usize), BenchError> {
+) -> Result<(f64, f64, usize, usize), BenchError> {
     let options = MobilityOptions {
         krylov_tolerance: tol.unwrap_or(1e-6),
+        ewald_tolerance: tol.unwrap_or(1e-6).clamp(1e-12, 0.1),
         ..MobilityOptions::default()
     };
     let t = Instant::now();
@@ -107,7 +113,8 @@ fn measure(
             x.len()
         ))
     })?;
-    Ok((sum / reps as f64, error, mob.krylov_iterations()))
+    let grid = mob.ewald_summary().map_or(0, |s| s.grid);
+    Ok((sum / reps as f64, error, mob.krylov_iterations(), grid))
 }
 
 /// Measure every method at every size and volume fraction.
@@ -126,6 +133,12 @@ pub fn cost_points(sizes: &CostChartSizes) -> Result<Vec<CostPoint>, BenchError>
             .iter()
             .map(|&t| (MobilityMethod::Krylov, Some(t))),
     );
+    variants.extend(
+        sizes
+            .krylov_tolerances
+            .iter()
+            .map(|&t| (MobilityMethod::SpectralEwald, Some(t))),
+    );
     let mut points = Vec::new();
     for (k, &phi) in sizes.volume_fractions.iter().enumerate() {
         for &n in &sizes.sizes {
@@ -143,7 +156,7 @@ pub fn cost_points(sizes: &CostChartSizes) -> Result<Vec<CostPoint>, BenchError>
                     &|m| covariance_error(m, &exact),
                     sizes.min_time,
                 ) {
-                    Ok((cost_s, error, iterations)) => {
+                    Ok((cost_s, error, iterations, grid)) => {
                         let p = CostPoint {
                             volume_fraction: phi,
                             n,
@@ -153,6 +166,7 @@ pub fn cost_points(sizes: &CostChartSizes) -> Result<Vec<CostPoint>, BenchError>
                             error,
                             plotted_error: error.max(ERROR_FLOOR),
                             krylov_iterations: iterations,
+                            ewald_grid: grid,
                         };
                         eprintln!(
                             "phi {phi:.0e} N {n} {}{}: cost {:.3e} s, error {:.3e}",
@@ -213,6 +227,15 @@ fn panel(points: &[CostPoint], phi: f64, sizes: &[usize]) -> Chart {
             Series::new(
                 format!("Krylov, tol 1e-2..1e-8, N = {n}"),
                 of("krylov", Some(n)),
+            )
+            .style(Style::LineMarkers),
+        );
+    }
+    for &n in sizes {
+        chart = chart.series(
+            Series::new(
+                format!("spectral Ewald (matrix-free), tol 1e-2..1e-8, N = {n}"),
+                of("spectral_ewald", Some(n)),
             )
             .style(Style::LineMarkers),
         );

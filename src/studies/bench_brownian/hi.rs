@@ -6,9 +6,12 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use glam::DVec3;
-use magsep_systems::brownian::hydro::{Mobility, MobilityMethod, MobilityOptions};
+use magsep_systems::brownian::hydro::{
+    EwaldSummary, Mobility, MobilityMethod, MobilityOptions, rpy_block,
+};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
 
 use crate::studies::bench::BenchError;
 
@@ -56,6 +59,8 @@ pub struct MobilityStepTime {
     pub total_s: f64,
     /// Krylov iterations of the noise draw (0 for the other methods).
     pub krylov_iterations: usize,
+    /// Parameters of the spectral Ewald operator (None for the other methods).
+    pub ewald: Option<EwaldSummary>,
 }
 
 /// Prepare `method` at `x` with the given options and time it with one noise draw; returns
@@ -98,6 +103,25 @@ pub fn time_mobility_step(
     krylov_tolerance: f64,
     reps: usize,
 ) -> Result<MobilityStepTime, BenchError> {
+    let options = MobilityOptions {
+        krylov_tolerance,
+        ..MobilityOptions::default()
+    };
+    time_mobility_step_with(method, x, radii, viscosity, options, reps)
+}
+
+/// As [`time_mobility_step`] with all mobility options.
+///
+/// # Errors
+/// As [`time_mobility_step`].
+pub fn time_mobility_step_with(
+    method: MobilityMethod,
+    x: &[DVec3],
+    radii: &[f64],
+    viscosity: f64,
+    options: MobilityOptions,
+    reps: usize,
+) -> Result<MobilityStepTime, BenchError> {
     let n = x.len();
     let w = normal_vectors(n, 3);
     // forces of order k_B T / R
@@ -105,10 +129,6 @@ pub fn time_mobility_step(
         .into_iter()
         .map(|v| v * 4e-21 / radii.first().copied().unwrap_or(1.0))
         .collect();
-    let options = MobilityOptions {
-        krylov_tolerance,
-        ..MobilityOptions::default()
-    };
     let mut best: Option<MobilityStepTime> = None;
     for _ in 0..reps.max(1) {
         let (mob, prepare_s, noise_s) = prepare_and_draw(method, x, radii, viscosity, options, &w)?;
@@ -123,6 +143,7 @@ pub fn time_mobility_step(
             apply_s,
             total_s: prepare_s + noise_s + apply_s,
             krylov_iterations: mob.krylov_iterations(),
+            ewald: mob.ewald_summary(),
         };
         drop(mob);
         if best.is_none_or(|b| r.total_s < b.total_s) {
@@ -130,4 +151,41 @@ pub fn time_mobility_step(
         }
     }
     best.ok_or_else(|| BenchError::Runtime("no repetition".into()))
+}
+
+/// Relative error ‖v − μF‖/‖μF‖ of `method`'s product `v` against the RPY product μF summed
+/// directly (O(N²) pair blocks, never stored), for standard-normal forces.
+///
+/// # Errors
+/// [`BenchError::Runtime`] when the mobility fails.
+pub fn product_error(
+    method: MobilityMethod,
+    x: &[DVec3],
+    radii: &[f64],
+    viscosity: f64,
+    options: MobilityOptions,
+) -> Result<f64, BenchError> {
+    let n = x.len();
+    let f = normal_vectors(n, 6);
+    let mob = Mobility::new_with(method, x, radii, viscosity, options)
+        .map_err(|e| BenchError::Runtime(format!("{method:?} mobility at N = {n}: {e}")))?;
+    let mut v = vec![DVec3::ZERO; n];
+    mob.apply(&f, &mut v);
+    let exact: Vec<DVec3> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let mut acc = f[i] / (6.0 * std::f64::consts::PI * viscosity * radii[i]);
+            for j in (0..n).filter(|&j| j != i) {
+                acc += rpy_block(x[i] - x[j], radii[i], radii[j], viscosity) * f[j];
+            }
+            acc
+        })
+        .collect();
+    let num: f64 = v
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (*a - *b).length_squared())
+        .sum();
+    let den: f64 = exact.iter().map(|b| b.length_squared()).sum();
+    Ok((num / den).sqrt())
 }

@@ -19,7 +19,7 @@ use magsep_components::prelude::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::dynamics::{HydroState, PipelineDynamics};
-use super::hydro::{Mobility, MobilityMethod, auto_method};
+use super::hydro::{Mobility, MobilityMethod, MobilityOptions, auto_method};
 use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
 use super::stepper::advance;
@@ -168,6 +168,7 @@ pub fn init_brownian_workspace(world: &mut World) {
         MobilityChoice::Cholesky => (MobilityMethod::Cholesky, "chosen in the scene"),
         MobilityChoice::Tea => (MobilityMethod::Tea, "chosen in the scene"),
         MobilityChoice::Krylov => (MobilityMethod::Krylov, "chosen in the scene"),
+        MobilityChoice::SpectralEwald => (MobilityMethod::SpectralEwald, "chosen in the scene"),
     };
     let mut stats = world
         .get_resource::<BrownianStats>()
@@ -347,7 +348,12 @@ pub fn prepare_mobility(
     }
     let x: Vec<DVec3> = rows.iter().map(|&i| ws.positions[i]).collect();
     let a: Vec<f64> = rows.iter().map(|&i| ws.radii[i]).collect();
-    match Mobility::new(ws.method, &x, &a, config.viscosity, config.krylov_tolerance) {
+    let options = MobilityOptions {
+        krylov_tolerance: config.krylov_tolerance,
+        ewald_tolerance: config.ewald_tolerance,
+        ..MobilityOptions::default()
+    };
+    match Mobility::new_with(ws.method, &x, &a, config.viscosity, options) {
         Ok(mobility) => {
             stats.krylov_iterations += mobility.krylov_iterations() as u64;
             ws.hydro = Some(HydroState { mobility, rows });

@@ -19,6 +19,10 @@
 //! * [`MobilityMethod::Tea`]: TEA-HI of Geyer & Winter (2009), see [`tea`] (O(N²)).
 //! * [`MobilityMethod::Krylov`]: Lanczos approximation of μ^{1/2} w (Ando et al. 2012), see
 //!   [`krylov`] (O(m N²), m iterations).
+//! * [`MobilityMethod::SpectralEwald`]: no matrix at all: the product μF by free-space
+//!   spectral Ewald summation to a relative tolerance [`MobilityOptions::ewald_tolerance`]
+//!   (see [`ewald`], O(N log N) per product for a fixed tolerance), and the noise by Lanczos
+//!   over that product (O(m N log N)).
 //!
 //! All dense products are row-chunk parallel (rayon) with a fixed per-element summation
 //! order, so every output is bitwise identical whatever the rayon thread count.
@@ -30,6 +34,7 @@
 //! # Assumptions
 //! Unbounded fluid (no fibre/wall hydrodynamics), pairwise RPY, translations only.
 
+pub mod ewald;
 pub mod krylov;
 pub mod rpy;
 mod select;
@@ -37,8 +42,11 @@ pub mod tea;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_ewald;
+#[cfg(test)]
 mod tests_noise;
 
+pub use ewald::EwaldSummary;
 pub use rpy::{rpy_block, rpy_matrix};
 pub use select::{auto_method, covariance_error};
 pub use tea::TeaStats;
@@ -59,6 +67,8 @@ pub enum MobilityMethod {
     Tea,
     /// dense RPY + Krylov/Lanczos square root
     Krylov,
+    /// matrix-free RPY product by free-space spectral Ewald + Krylov/Lanczos square root
+    SpectralEwald,
 }
 
 /// Errors preparing or using a [`Mobility`].
@@ -106,6 +116,8 @@ pub struct MobilityOptions {
     pub krylov_max_iterations: usize,
     /// run faer's Cholesky with rayon parallelism (default false: `Par::Seq`)
     pub parallel_cholesky: bool,
+    /// relative accuracy of the spectral Ewald product (default 1e-6; 1e-12 … 0.1)
+    pub ewald_tolerance: f64,
 }
 
 impl Default for MobilityOptions {
@@ -114,6 +126,7 @@ impl Default for MobilityOptions {
             krylov_tolerance: 1e-6,
             krylov_max_iterations: 200,
             parallel_cholesky: false,
+            ewald_tolerance: 1e-6,
         }
     }
 }
@@ -124,6 +137,7 @@ enum Inner {
     Cholesky { m: DenseSym, l: faer::Mat<f64> },
     Tea { m: DenseSym, tea: tea::Tea },
     Krylov { m: DenseSym },
+    SpectralEwald { op: Box<ewald::SpectralEwald> },
 }
 
 /// The mobility prepared at one configuration.
@@ -197,7 +211,7 @@ impl Mobility {
         if positions.iter().any(|p| !p.is_finite()) {
             return Err(HydroError::InvalidInput("positions must be finite"));
         }
-        if options.krylov_tolerance.is_nan() || options.krylov_tolerance <= 0.0 {
+        if !options.krylov_tolerance.is_finite() || options.krylov_tolerance <= 0.0 {
             return Err(HydroError::InvalidInput("krylov_tolerance must be > 0"));
         }
         let inner = match method {
@@ -216,6 +230,14 @@ impl Mobility {
             }
             MobilityMethod::Krylov => Inner::Krylov {
                 m: DenseSym::rpy(positions, radii, viscosity),
+            },
+            MobilityMethod::SpectralEwald => Inner::SpectralEwald {
+                op: Box::new(ewald::SpectralEwald::new(
+                    positions,
+                    radii,
+                    viscosity,
+                    options.ewald_tolerance,
+                )?),
             },
         };
         Ok(Self {
@@ -254,6 +276,15 @@ impl Mobility {
         }
     }
 
+    /// Parameters of the spectral Ewald operator (None for the other methods).
+    #[must_use]
+    pub fn ewald_summary(&self) -> Option<EwaldSummary> {
+        match &self.inner {
+            Inner::SpectralEwald { op } => Some(op.summary()),
+            _ => None,
+        }
+    }
+
     /// Krylov iterations (matrix-vector products) used by the most recent successful
     /// [`Mobility::noise`] call on this value (0 for other methods or before any call).
     /// Stored in an atomic, so `Mobility` stays `Sync`; with concurrent calls it reports one
@@ -263,8 +294,8 @@ impl Mobility {
         self.last_iterations.load(Ordering::Relaxed)
     }
 
-    /// Velocities v = μ F [m/s]; `forces` and `out` have length N. O(N) free draining, O(N²)
-    /// otherwise.
+    /// Velocities v = μ F [m/s]; `forces` and `out` have length N. O(N) free draining,
+    /// O(N log N) spectral Ewald (to its tolerance), O(N²) otherwise.
     pub fn apply(&self, forces: &[DVec3], out: &mut [DVec3]) {
         assert_eq!(forces.len(), self.n, "forces length");
         assert_eq!(out.len(), self.n, "out length");
@@ -273,6 +304,13 @@ impl Mobility {
                 for ((o, f), mu) in out.iter_mut().zip(forces).zip(mob) {
                     *o = *f * *mu;
                 }
+                return;
+            }
+            Inner::SpectralEwald { op } => {
+                let f = flatten(forces);
+                let mut v = vec![0.0; f.len()];
+                op.apply(&f, &mut v);
+                unflatten(&v, out);
                 return;
             }
             Inner::Cholesky { m, .. } | Inner::Tea { m, .. } | Inner::Krylov { m } => m,
@@ -305,6 +343,17 @@ impl Mobility {
             Inner::Krylov { m } => {
                 let res = krylov::lanczos_sqrt(
                     |x, o| m.matvec(x, o),
+                    &wf,
+                    self.options.krylov_tolerance,
+                    self.options.krylov_max_iterations,
+                )?;
+                self.last_iterations
+                    .store(res.iterations, Ordering::Relaxed);
+                y = res.y;
+            }
+            Inner::SpectralEwald { op } => {
+                let res = krylov::lanczos_sqrt(
+                    |x, o| op.apply(x, o),
                     &wf,
                     self.options.krylov_tolerance,
                     self.options.krylov_max_iterations,

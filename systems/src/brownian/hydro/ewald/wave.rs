@@ -1,0 +1,359 @@
+//! Wave-space (smooth, long-ranged) part of the spectral Ewald RPY product in free space.
+//!
+//! u_i^wave = h⁶ Σ_n g(y_n − x_i) Σ_m K(y_n − y_m) Σ_j g(y_m − x_j) q_j on a uniform grid y of
+//! spacing h: Gaussian spreading g(x) = (2ξ²/πη)^{3/2} e^{−2ξ²|x|²/η} truncated to P³ points
+//! (spectral Ewald, Lindbo & Tornberg 2010), the middle kernel K sampled in real space
+//! (closed forms in [`super::kernels`], smooth because it carries the Gaussian e^{−(1−η)k²/4ξ²}),
+//! an aperiodic discrete convolution by zero-padded FFTs ([`super::fft3`]), and gathering with
+//! the same Gaussian (trapezoidal rule). Because the convolution is aperiodic there are no
+//! periodic images: the result is the free-space sum.
+//!
+//! Two source densities handle polydispersity: q = f and q = a²f, with
+//! u_i = (S̃∗f)_i + (a_i²/6)(L̃∗f)_i + (L̃∗(a²f))_i/6 (S̃, L̃ the wave parts of the Stokeslet and
+//! of its Laplacian). For equal radii these fold into one kernel S̃ + (a²/3) L̃ (3 instead of 6
+//! transforms each way).
+
+use glam::DVec3;
+use rayon::prelude::*;
+use realfft::num_complex::Complex64;
+use std::f64::consts::PI;
+
+use std::sync::{Arc, Mutex};
+
+use super::fft3::Fft3;
+use super::kernels::{smoothed_laplacian, wave_stokeslet};
+use super::params::{Params, SPLIT};
+
+/// Symmetric 3×3 kernel at one wavenumber: xx, yy, zz, xy, xz, yz (real: the sampled
+/// kernels are even).
+type Sym = [f64; 6];
+
+/// The prepared wave-space operator of one configuration.
+#[derive(Debug)]
+pub(crate) struct Wave {
+    fft: Fft3,
+    support: usize,
+    /// per particle: first grid index per axis
+    start: Vec<[usize; 3]>,
+    /// per particle: P weights per axis (x block, y block, z block)
+    weights: Vec<f64>,
+    /// per x-plane: the particles whose support covers it, increasing index
+    plane_members: Vec<Vec<u32>>,
+    /// Stokeslet kernel (or the combined S̃ + a²/3 L̃ for equal radii), scaled
+    kernel_s: Arc<Vec<Sym>>,
+    /// Laplacian kernel for unequal radii, scaled
+    kernel_l: Option<Arc<Vec<Sym>>>,
+    radii_sq: Vec<f64>,
+}
+
+/// The kernel spectra of one grid: Stokeslet (or combined) and, for unequal radii, Laplacian.
+type Spectra = (Arc<Vec<Sym>>, Option<Arc<Vec<Sym>>>);
+
+/// Cache key: FFT length and the bits of h, ξ, α, the prefactor and the common a² (NaN bits for
+/// unequal radii).
+type Key = (usize, [u64; 5]);
+
+/// The most recent kernel spectra (a step rebuilds the mobility at a configuration whose grid
+/// parameters rarely change). Recomputing gives bitwise the same values, so the cache cannot
+/// change results.
+static CACHE: Mutex<Vec<(Key, Spectra)>> = Mutex::new(Vec::new());
+
+/// Entries kept in [`CACHE`].
+const CACHE_ENTRIES: usize = 3;
+
+/// Sampled kernel DFT (real part) in T layout, scaled by `scale`.
+fn kernel_spectrum(
+    fft: &Fft3,
+    h: f64,
+    scale: f64,
+    eval: &(dyn Fn(f64) -> (f64, f64) + Sync),
+) -> Vec<Sym> {
+    let n = fft.n;
+    // displacement index i ↦ i for i ≤ n/2, i − n above. Only |d| < m is ever used by the
+    // convolution (n ≥ 2m), so the kernel does not depend on m and can be cached by n.
+    let disp = |i: usize| -> Option<f64> {
+        if i <= n / 2 {
+            Some(i as f64)
+        } else {
+            Some(i as f64 - n as f64)
+        }
+    };
+    let mut samples = vec![0.0; n * n * n * 6];
+    samples
+        .par_chunks_mut(n * n * 6)
+        .enumerate()
+        .for_each(|(ix, plane)| {
+            let Some(dx) = disp(ix) else { return };
+            for iy in 0..n {
+                let Some(dy) = disp(iy) else { continue };
+                for iz in 0..n {
+                    let Some(dz) = disp(iz) else { continue };
+                    let d = DVec3::new(dx, dy, dz) * h;
+                    let r = d.length();
+                    let (a, b) = eval(r);
+                    let f = if r > 0.0 { b / (r * r) } else { 0.0 };
+                    let o = &mut plane[(iy * n + iz) * 6..(iy * n + iz) * 6 + 6];
+                    o[0] = a + f * d.x * d.x;
+                    o[1] = a + f * d.y * d.y;
+                    o[2] = a + f * d.z * d.z;
+                    o[3] = f * d.x * d.y;
+                    o[4] = f * d.x * d.z;
+                    o[5] = f * d.y * d.z;
+                }
+            }
+        });
+    let full = Fft3::new(n, n);
+    let mut spec = vec![Complex64::new(0.0, 0.0); fft.spectrum_len()];
+    let mut out = vec![[0.0; 6]; fft.spectrum_len()];
+    for c in 0..6 {
+        full.forward(&samples, 6, c, &mut spec);
+        for (o, s) in out.iter_mut().zip(&spec) {
+            o[c] = s.re * scale;
+        }
+    }
+    out
+}
+
+#[inline]
+fn sym_mul(k: &Sym, v: [Complex64; 3]) -> [Complex64; 3] {
+    [
+        v[0] * k[0] + v[1] * k[3] + v[2] * k[4],
+        v[0] * k[3] + v[1] * k[1] + v[2] * k[5],
+        v[0] * k[4] + v[1] * k[5] + v[2] * k[2],
+    ]
+}
+
+impl Wave {
+    /// Prepare the grid, the spreading weights and the kernel spectra. `params` must not be
+    /// the direct sum. Units: output velocities in 1/(8πη) units times `prefactor`.
+    pub fn new(params: &Params, positions: &[DVec3], radii: &[f64], prefactor: f64) -> Self {
+        let (m, n, p, h) = (params.m, params.fft_n, params.support, params.h);
+        let xi = params.xi;
+        let fft = Fft3::new(n, m);
+        // spreading Gaussian per axis: (2ξ²/πη)^{1/2} e^{−2ξ²d²/η}
+        let c_exp = 2.0 * xi * xi / SPLIT;
+        let c_norm = (c_exp / PI).sqrt();
+        let mut start = Vec::with_capacity(positions.len());
+        let mut weights = Vec::with_capacity(positions.len() * 3 * p);
+        for x in positions {
+            let t = (*x - params.origin) / h;
+            let mut s = [0usize; 3];
+            for k in 0..3 {
+                let m0 = (t[k].floor() as i64 - (p as i64 - 1) / 2).clamp(0, (m - p) as i64);
+                s[k] = m0 as usize;
+                for q in 0..p {
+                    let d = (t[k] - (m0 as usize + q) as f64) * h;
+                    weights.push(c_norm * (-c_exp * d * d).exp());
+                }
+            }
+            start.push(s);
+        }
+        let mut plane_members = vec![Vec::new(); m];
+        for (i, s) in start.iter().enumerate() {
+            for plane in plane_members.iter_mut().skip(s[0]).take(p) {
+                plane.push(i as u32);
+            }
+        }
+        let mono = radii.windows(2).all(|w| w[0] == w[1]);
+        let h3 = h * h * h;
+        let scale = prefactor * h3 * h3 / (n as f64).powi(3);
+        let alpha = params.alpha;
+        let a2 = if mono {
+            radii.first().map_or(0.0, |a| a * a)
+        } else {
+            f64::NAN
+        };
+        let key = (
+            n,
+            [
+                h.to_bits(),
+                xi.to_bits(),
+                alpha.to_bits(),
+                prefactor.to_bits(),
+                a2.to_bits(),
+            ],
+        );
+        let cached = CACHE
+            .lock()
+            .ok()
+            .and_then(|c| c.iter().find(|(k, _)| *k == key).map(|(_, v)| v.clone()));
+        let (kernel_s, kernel_l) = cached.unwrap_or_else(|| {
+            let spectra: Spectra = if mono {
+                let k = kernel_spectrum(&fft, h, scale, &|r| {
+                    let (sa, sb) = wave_stokeslet(r, alpha, xi);
+                    let (la, lb) = smoothed_laplacian(r, alpha);
+                    (sa + a2 / 3.0 * la, sb + a2 / 3.0 * lb)
+                });
+                (Arc::new(k), None)
+            } else {
+                let ks = kernel_spectrum(&fft, h, scale, &|r| wave_stokeslet(r, alpha, xi));
+                let kl = kernel_spectrum(&fft, h, scale / 6.0, &|r| smoothed_laplacian(r, alpha));
+                (Arc::new(ks), Some(Arc::new(kl)))
+            };
+            if let Ok(mut c) = CACHE.lock() {
+                if c.len() >= CACHE_ENTRIES {
+                    c.remove(0);
+                }
+                c.push((key, spectra.clone()));
+            }
+            spectra
+        });
+        Self {
+            fft,
+            support: p,
+            start,
+            weights,
+            plane_members,
+            kernel_s,
+            kernel_l,
+            radii_sq: radii.iter().map(|a| a * a).collect(),
+        }
+    }
+
+    /// Spread `nf` interleaved source fields (`src(i)` gives particle i's values) onto the
+    /// compact grid, layout `((ix * m + iy) * m + iz) * nf + c`.
+    fn spread(&self, nf: usize, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
+        let (m, p) = (self.fft.m, self.support);
+        let mut grid = vec![0.0; m * m * m * nf];
+        grid.par_chunks_mut(m * m * nf)
+            .enumerate()
+            .for_each(|(ix, plane)| {
+                let mut q = [0.0; 6];
+                for &i in &self.plane_members[ix] {
+                    let i = i as usize;
+                    let s = self.start[i];
+                    let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+                    let wx = w[ix - s[0]];
+                    for (c, qc) in q.iter_mut().enumerate().take(nf) {
+                        *qc = src(i, c) * wx;
+                    }
+                    for a in 0..p {
+                        let wy = w[p + a];
+                        let row = (s[1] + a) * m + s[2];
+                        for b in 0..p {
+                            let wyz = wy * w[2 * p + b];
+                            let o = &mut plane[(row + b) * nf..(row + b + 1) * nf];
+                            for (oc, qc) in o.iter_mut().zip(&q) {
+                                *oc += qc * wyz;
+                            }
+                        }
+                    }
+                }
+            });
+        grid
+    }
+
+    /// Gather the `nf` interleaved fields at particle `i`.
+    fn gather(&self, grid: &[f64], nf: usize, i: usize) -> [f64; 6] {
+        let (m, p) = (self.fft.m, self.support);
+        let s = self.start[i];
+        let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+        let mut acc = [0.0; 6];
+        for a in 0..p {
+            let mut acc_y = [0.0; 6];
+            for b in 0..p {
+                let wy = w[p + b];
+                let mut acc_z = [0.0; 6];
+                let base = (((s[0] + a) * m + s[1] + b) * m + s[2]) * nf;
+                for c in 0..p {
+                    let wz = w[2 * p + c];
+                    for (f, az) in acc_z.iter_mut().enumerate().take(nf) {
+                        *az += grid[base + c * nf + f] * wz;
+                    }
+                }
+                for f in 0..nf {
+                    acc_y[f] += acc_z[f] * wy;
+                }
+            }
+            for f in 0..nf {
+                acc[f] += acc_y[f] * w[a];
+            }
+        }
+        acc
+    }
+
+    /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
+    pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
+        let len = self.fft.spectrum_len();
+        let zero = Complex64::new(0.0, 0.0);
+        let nf = if self.kernel_l.is_some() { 6 } else { 3 };
+        let grid = self.spread(nf, &|i, c| {
+            if c < 3 {
+                f[3 * i + c]
+            } else {
+                self.radii_sq[i] * f[3 * i + c - 3]
+            }
+        });
+        let mut spec: Vec<Vec<Complex64>> = (0..nf)
+            .map(|c| {
+                let mut s = vec![zero; len];
+                self.fft.forward(&grid, nf, c, &mut s);
+                s
+            })
+            .collect();
+        drop(grid);
+        const CHUNK: usize = 4096;
+        match &self.kernel_l {
+            None => {
+                let [s0, s1, s2] = &mut spec[..] else { return };
+                (
+                    s0.par_chunks_mut(CHUNK),
+                    s1.par_chunks_mut(CHUNK),
+                    s2.par_chunks_mut(CHUNK),
+                    self.kernel_s.par_chunks(CHUNK),
+                )
+                    .into_par_iter()
+                    .for_each(|(a, b, c, k)| {
+                        for j in 0..a.len() {
+                            let v = sym_mul(&k[j], [a[j], b[j], c[j]]);
+                            (a[j], b[j], c[j]) = (v[0], v[1], v[2]);
+                        }
+                    });
+            }
+            Some(kl) => {
+                let [s0, s1, s2, t0, t1, t2] = &mut spec[..] else {
+                    return;
+                };
+                (
+                    (
+                        s0.par_chunks_mut(CHUNK),
+                        s1.par_chunks_mut(CHUNK),
+                        s2.par_chunks_mut(CHUNK),
+                    ),
+                    (
+                        t0.par_chunks_mut(CHUNK),
+                        t1.par_chunks_mut(CHUNK),
+                        t2.par_chunks_mut(CHUNK),
+                    ),
+                    self.kernel_s.par_chunks(CHUNK),
+                    kl.par_chunks(CHUNK),
+                )
+                    .into_par_iter()
+                    .for_each(|((a, b, c), (d, e, g), ks, kl)| {
+                        for j in 0..a.len() {
+                            let fv = [a[j], b[j], c[j]];
+                            let u1 = sym_mul(&ks[j], fv);
+                            let u2 = sym_mul(&kl[j], [d[j], e[j], g[j]]);
+                            let u3 = sym_mul(&kl[j], fv);
+                            (a[j], b[j], c[j]) = (u1[0] + u2[0], u1[1] + u2[1], u1[2] + u2[2]);
+                            (d[j], e[j], g[j]) = (u3[0], u3[1], u3[2]);
+                        }
+                    });
+            }
+        }
+        let m = self.fft.m;
+        let mut field = vec![0.0; m * m * m * nf];
+        for (c, s) in spec.iter_mut().enumerate() {
+            self.fft.inverse(s, &mut field, nf, c);
+        }
+        out.par_chunks_mut(3).enumerate().for_each(|(i, o)| {
+            let g = self.gather(&field, nf, i);
+            let a2 = self.radii_sq[i];
+            for k in 0..3 {
+                // second field group: (L̃∗f)/6, weighted by the target's a²
+                let extra = if nf == 6 { a2 * g[3 + k] } else { 0.0 };
+                o[k] += g[k] + extra;
+            }
+        });
+    }
+}
