@@ -51,10 +51,11 @@ impl Default for ReaderLimits {
 /// Default [`ReaderLimits::max_chunk_bytes`] (1 GiB); the writer refuses larger frames.
 pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
 
-/// Chunks that decompress to at most this many bytes (1 MiB) are exempt from
-/// [`ReaderLimits::max_compression_ratio`]: small chunks (schemas, a frame of few particles)
-/// may compress well without costing memory.
-pub const RATIO_FREE_BYTES: u64 = 1 << 20;
+/// Chunks that decompress to at most this many bytes (16 MiB) are exempt from
+/// [`ReaderLimits::max_compression_ratio`]: small chunks (schemas, a frame of few particles,
+/// the up-to-1-MiB chunks of buffered frames, which compress ~100:1 when frames differ little)
+/// may compress well without costing much memory.
+pub const RATIO_FREE_BYTES: u64 = 16 << 20;
 
 /// Decompresses the chunk record body `body` and checks its CRC; returns the records it holds.
 /// Memory: the declared uncompressed size, which is checked first against

@@ -126,3 +126,45 @@ fn finish_syncs_only_when_asked() {
         assert_eq!(syncs.load(Ordering::Relaxed), usize::from(synced));
     }
 }
+
+/// Buffered chunks of nearly equal frames compress far beyond the reader's ratio limit (one
+/// particle, a 1 MiB chunk, ~100:1): they must read back (they are exempt by size), with the
+/// default buffering policy the pipelines use.
+#[test]
+fn a_full_buffered_chunk_of_similar_frames_reads_back() {
+    let mut frame = random_frames(14, 1, false).remove(0);
+    let path = TempFile::new("buffered_similar.mcap");
+    let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
+    w.buffer_frames(Some(FrameBuffering::default()));
+    // a magnet's colour map, as the particle-fluid pipeline draws it
+    w.set_backdrop(
+        (0..20)
+            .map(|k| crate::BackdropCube {
+                center: glam::DVec3::new(0.5, 0.5, 0.05 * k as f64),
+                size: glam::DVec3::new(1.0, 1.0, 0.05),
+                colour: [0.9, 0.3, 0.2, 0.1],
+            })
+            .collect(),
+    );
+    let mut frames = Vec::new();
+    for k in 0..6000u64 {
+        frame.step = k;
+        frame.time = k as f64 * 1e-3;
+        w.write_frame(&frame, None).unwrap();
+        frames.push(frame.clone());
+    }
+    w.finish().unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let rec = read_recording_bytes(&bytes).unwrap();
+    assert!(rec.truncated.is_none());
+    assert_frames_bitwise_eq(&rec.frames, &frames);
+    // the premise: a chunk beyond the 64:1 ratio limit, exempt because it is small
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("summary");
+    let ratio = summary
+        .chunk_indexes
+        .iter()
+        .map(|c| c.uncompressed_size / c.compressed_size.max(1))
+        .max()
+        .unwrap();
+    assert!(ratio > 64, "best chunk ratio {ratio}");
+}

@@ -125,14 +125,14 @@ fn record_crafted_huge_lengths_are_errors_not_allocations() {
     let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
     assert!(detail.contains("compression ratio above"), "{detail}");
     // Declared smaller than the data decompresses to: decompression stops, no overrun.
-    let big = zstd::bulk::compress(&vec![7u8; 1 << 20], 3).unwrap();
+    let big = zstd::bulk::compress(&vec![7u8; RATIO_FREE_BYTES as usize], 3).unwrap();
     let bytes = crafted_chunk(100, "zstd", &big, true);
     let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
     assert!(
         detail.contains("decompresses to more than the 100 bytes"),
         "{detail}"
     );
-    // 1 MiB of one byte value is a ratio of thousands: allowed up to RATIO_FREE_BYTES (the
+    // 16 MiB of one byte value is a ratio of thousands: allowed up to RATIO_FREE_BYTES (the
     // chunk then fails on its content), refused one byte above it.
     let bytes = crafted_chunk(RATIO_FREE_BYTES, "zstd", &big, true);
     let (_, detail) = corrupt_detail(read_recording_bytes(&bytes));
