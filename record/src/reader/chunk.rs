@@ -58,9 +58,10 @@ pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
 pub const RATIO_FREE_BYTES: u64 = 16 << 20;
 
 /// Decompresses the chunk record body `body` and checks its CRC; returns the records it holds.
-/// Memory: the declared uncompressed size, which is checked first against
+/// Memory: at most what the data decompresses to (grown as it comes, up to twice that in
+/// capacity), never past the declared uncompressed size, which is checked first against
 /// `limits.max_chunk_bytes` and against `limits.max_compression_ratio` times the compressed
-/// size; decompression never writes past it.
+/// size.
 pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, String> {
     let mut c = Cursor::new(body);
     c.u64("message start time")?;
@@ -129,21 +130,27 @@ pub(crate) fn decompress(body: &[u8], limits: &ReaderLimits) -> Result<Vec<u8>, 
 /// of that size, allocated fallibly, and an error if the data gives fewer or more bytes.
 fn inflate(data: &[u8], size: u64) -> Result<Vec<u8>, String> {
     let n = usize::try_from(size).map_err(|_| format!("uncompressed size {size} is too large"))?;
-    let mut out = Vec::new();
-    out.try_reserve_exact(n)
-        .map_err(|_| format!("cannot allocate {size} bytes for the decompressed chunk"))?;
-    out.resize(n, 0);
     let mut decoder =
         zstd::stream::read::Decoder::new(data).map_err(|e| format!("zstd decoder: {e}"))?;
-    let mut filled = 0;
-    while filled < n {
-        match decoder.read(&mut out[filled..]) {
+    // The output grows with what the data really decompresses to (never past `n`), so a
+    // damaged declared size costs no memory beyond the chunk's true content.
+    let mut out = Vec::new();
+    let mut scratch = vec![0u8; n.min(64 << 10)];
+    while out.len() < n {
+        let want = (n - out.len()).min(scratch.len());
+        match decoder.read(&mut scratch[..want]) {
             Ok(0) => break,
-            Ok(k) => filled += k,
+            Ok(k) => {
+                out.try_reserve(k).map_err(|_| {
+                    format!("cannot allocate {size} bytes for the decompressed chunk")
+                })?;
+                out.extend_from_slice(&scratch[..k]);
+            }
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
             Err(e) => return Err(format!("zstd decompression failed: {e}")),
         }
     }
+    let filled = out.len();
     if filled < n {
         return Err(format!(
             "zstd data decompresses to {filled} bytes, but the chunk declares {size}"
