@@ -263,22 +263,18 @@ pub fn bench_brownian_with(
             emit(
                 &mut rows,
                 as_json,
-                json!({
-                    "name": format!("brownian_hi_{}", method_name(method)),
-                    "bench": "brownian",
-                    "case": "hi",
-                    "method": method_name(method),
-                    "n": hn,
-                    "threads": threads,
-                    "volume_fraction": HI_VOLUME_FRACTION,
-                    "repetitions": hi_reps(hn),
-                    "prepare_s": t.prepare_s,
-                    "noise_s": t.noise_s,
-                    "apply_s": t.apply_s,
-                    "s_per_step": t.total_s,
-                    "steps_per_s": 1.0 / t.total_s,
-                    "krylov_iterations": t.krylov_iterations,
-                }),
+                t.with_fields(
+                    json!({
+                        "name": format!("brownian_hi_{}", method_name(method)),
+                        "bench": "brownian",
+                        "case": "hi",
+                        "method": method_name(method),
+                        "n": hn,
+                        "threads": threads,
+                        "volume_fraction": HI_VOLUME_FRACTION,
+                    }),
+                    hi_reps(hn),
+                ),
             )?;
         }
         if pts.len() >= 2 {
@@ -330,27 +326,23 @@ fn spectral_rows(
             emit(
                 rows,
                 as_json,
-                json!({
-                    "name": "brownian_hi_spectral_ewald",
-                    "bench": "brownian",
-                    "case": "hi_spectral",
-                    "method": method_name(method),
-                    "n": hn,
-                    "threads": threads,
-                    "volume_fraction": HI_VOLUME_FRACTION,
-                    "ewald_tolerance": SPECTRAL_EWALD_TOLERANCE,
-                    "krylov_tolerance": SPECTRAL_KRYLOV_TOLERANCE,
-                    "product_error": error,
-                    "ewald": t.ewald,
-                    "repetitions": hi_reps(hn),
-                    "prepare_s": t.prepare_s,
-                    "noise_s": t.noise_s,
-                    "apply_s": t.apply_s,
-                    "s_per_step": t.total_s,
-                    "steps_per_s": 1.0 / t.total_s,
-                    "krylov_iterations": t.krylov_iterations,
-                    "load_average_1min": load_average(),
-                }),
+                t.with_fields(
+                    json!({
+                        "name": "brownian_hi_spectral_ewald",
+                        "bench": "brownian",
+                        "case": "hi_spectral",
+                        "method": method_name(method),
+                        "n": hn,
+                        "threads": threads,
+                        "volume_fraction": HI_VOLUME_FRACTION,
+                        "ewald_tolerance": SPECTRAL_EWALD_TOLERANCE,
+                        "krylov_tolerance": SPECTRAL_KRYLOV_TOLERANCE,
+                        "product_error": error,
+                        "ewald": t.ewald,
+                        "load_average_1min": load_average(),
+                    }),
+                    hi_reps(hn),
+                ),
             )?;
         }
     }

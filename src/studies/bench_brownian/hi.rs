@@ -63,6 +63,30 @@ pub struct MobilityStepTime {
     pub ewald: Option<EwaldSummary>,
 }
 
+impl MobilityStepTime {
+    /// The row's timing keys (`prepare_s`, `noise_s`, `apply_s`, `s_per_step`, `steps_per_s`,
+    /// `krylov_iterations`) and `repetitions`, merged into `row` (a JSON object).
+    pub fn with_fields(&self, mut row: serde_json::Value, repetitions: usize) -> serde_json::Value {
+        if let Some(map) = row.as_object_mut() {
+            for (k, v) in [
+                ("repetitions", serde_json::json!(repetitions)),
+                ("prepare_s", serde_json::json!(self.prepare_s)),
+                ("noise_s", serde_json::json!(self.noise_s)),
+                ("apply_s", serde_json::json!(self.apply_s)),
+                ("s_per_step", serde_json::json!(self.total_s)),
+                ("steps_per_s", serde_json::json!(1.0 / self.total_s)),
+                (
+                    "krylov_iterations",
+                    serde_json::json!(self.krylov_iterations),
+                ),
+            ] {
+                map.insert(k.into(), v);
+            }
+        }
+        row
+    }
+}
+
 /// Prepare `method` at `x` with the given options and time it with one noise draw; returns
 /// the mobility, the preparation and the noise time [s].
 ///

@@ -340,31 +340,28 @@ impl Mobility {
                 matvec_cols(l.nrows(), |c| l.col_as_slice(c), &wf, &mut y, true);
             }
             Inner::Tea { m, tea } => tea.apply(m, &wf, &mut y),
-            Inner::Krylov { m } => {
-                let res = krylov::lanczos_sqrt(
-                    |x, o| m.matvec(x, o),
-                    &wf,
-                    self.options.krylov_tolerance,
-                    self.options.krylov_max_iterations,
-                )?;
-                self.last_iterations
-                    .store(res.iterations, Ordering::Relaxed);
-                y = res.y;
-            }
-            Inner::SpectralEwald { op } => {
-                let res = krylov::lanczos_sqrt(
-                    |x, o| op.apply(x, o),
-                    &wf,
-                    self.options.krylov_tolerance,
-                    self.options.krylov_max_iterations,
-                )?;
-                self.last_iterations
-                    .store(res.iterations, Ordering::Relaxed);
-                y = res.y;
-            }
+            Inner::Krylov { m } => y = self.lanczos(|x, o| m.matvec(x, o), &wf)?,
+            Inner::SpectralEwald { op } => y = self.lanczos(|x, o| op.apply(x, o), &wf)?,
         }
         unflatten(&y, out);
         Ok(())
+    }
+
+    /// μ^{1/2} w by Lanczos over the product `matvec`, recording the iterations.
+    fn lanczos(
+        &self,
+        matvec: impl Fn(&[f64], &mut [f64]),
+        w: &[f64],
+    ) -> Result<Vec<f64>, HydroError> {
+        let res = krylov::lanczos_sqrt(
+            matvec,
+            w,
+            self.options.krylov_tolerance,
+            self.options.krylov_max_iterations,
+        )?;
+        self.last_iterations
+            .store(res.iterations, Ordering::Relaxed);
+        Ok(res.y)
     }
 
     /// The dense 3N×3N factor B actually used by [`Mobility::noise`] (column k = B e_k;
