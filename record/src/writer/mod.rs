@@ -155,7 +155,7 @@ impl RecordingWriter {
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .library(format!("magsep-record/{}", env!("CARGO_PKG_VERSION")))
-            // Chunks end at every flush, i.e. once per frame.
+            // Chunks end at every flush: once per frame, or per batch of buffered frames.
             .chunk_size(None)
             // Compress on the calling thread: the crate's default (a zstd worker per physical
             // core) hands every chunk to a worker and waits for it, which cost a one-particle
