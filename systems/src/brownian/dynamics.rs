@@ -217,10 +217,22 @@ impl Dynamics for PipelineDynamics<'_> {
     }
 
     fn accept(&mut self, from: &[DVec3], x: &mut [DVec3], _t: f64) {
+        self.capture_swept(from, x, 0..x.len());
+    }
+
+    fn accept_moved(&mut self, from: &[DVec3], x: &mut [DVec3], moved: &[usize], _t: f64) {
+        self.capture_swept(from, x, moved.iter().copied());
+    }
+}
+
+impl PipelineDynamics<'_> {
+    /// Capture the free particles of `which` (ascending) whose path `from[i] → x[i]` comes
+    /// within capture distance of a fibre: they stop at the capture point and are fixed.
+    fn capture_swept(&mut self, from: &[DVec3], x: &mut [DVec3], which: impl Iterator<Item = usize>) {
         if self.model.sources.is_empty() {
             return;
         }
-        for i in 0..x.len() {
+        for i in which {
             if !self.mobile[i] {
                 continue;
             }

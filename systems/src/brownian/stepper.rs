@@ -57,6 +57,12 @@ pub trait Dynamics {
     /// An accepted (sub-)step from `from` to `x` ending at fraction `t` of the step: capture
     /// and quarantine. May fix particles (change [`Dynamics::mobile`]).
     fn accept(&mut self, _from: &[DVec3], _x: &mut [DVec3], _t: f64) {}
+    /// [`Dynamics::accept`] for a sub-step in which only the particles `moved` (ascending)
+    /// changed position (`x[i] == from[i]` for the others, which were checked when they last
+    /// moved). The default checks everyone.
+    fn accept_moved(&mut self, from: &[DVec3], x: &mut [DVec3], _moved: &[usize], t: f64) {
+        self.accept(from, x, t);
+    }
 }
 
 /// Draw one standard-normal vector.

@@ -284,10 +284,11 @@ fn accept_interval<D: Dynamics>(
 ) {
     let from = x.to_vec();
     let mut mid = from.clone();
+    let moved: Vec<usize> = accepted.iter().map(|&k| set[k]).collect();
     for &k in accepted {
         mid[set[k]] = xm[k];
     }
-    dynamics.accept(&from, &mut mid, s + 0.5 * h);
+    dynamics.accept_moved(&from, &mut mid, &moved, s + 0.5 * h);
     let mut end = mid.clone();
     for &k in accepted {
         let i = set[k];
@@ -296,7 +297,7 @@ fn accept_interval<D: Dynamics>(
             end[i] = x2[k];
         }
     }
-    dynamics.accept(&mid, &mut end, s + h);
+    dynamics.accept_moved(&mid, &mut end, &moved, s + h);
     for &k in accepted {
         let i = set[k];
         tracks[i] = Track {
