@@ -4,6 +4,7 @@
 use std::time::Duration;
 
 use super::{TempFile, assert_frames_bitwise_eq, metadata, random_frames};
+use crate::frame::FibreShape;
 use crate::{FrameBuffering, RecordingWriter, read_recording, read_recording_bytes};
 
 fn chunk_count(bytes: &[u8]) -> usize {
@@ -167,4 +168,64 @@ fn a_full_buffered_chunk_of_similar_frames_reads_back() {
         .max()
         .unwrap();
     assert!(ratio > 64, "best chunk ratio {ratio}");
+}
+
+/// Every message of `bytes` in file order: (channel topic, sequence, log time, payload).
+fn messages(bytes: &[u8]) -> Vec<(String, u32, u64, Vec<u8>)> {
+    mcap::MessageStream::new(bytes)
+        .unwrap()
+        .map(|m| {
+            let m = m.unwrap();
+            (
+                m.channel.topic.clone(),
+                m.sequence,
+                m.log_time,
+                m.data.to_vec(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn queued_frames_encode_to_the_messages_of_unqueued_ones() {
+    // small frames are queued and encoded in batches; a decoration change between frames
+    // (fibres here) must apply to the frames after it only, as when each frame is encoded
+    // at once
+    let frames = random_frames(14, 150, true);
+    let fibre = FibreShape {
+        center: glam::DVec3::ZERO,
+        axis: glam::DVec3::Z,
+        radius: 0.1,
+        half_length: 1.0,
+    };
+    let write = |buffered: bool| {
+        let path = TempFile::new(if buffered {
+            "queued.mcap"
+        } else {
+            "unqueued.mcap"
+        });
+        let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
+        if buffered {
+            w.buffer_frames(Some(FrameBuffering {
+                max_bytes: u64::MAX,
+                max_wait: Duration::from_secs(3600),
+            }));
+        }
+        for (k, f) in frames.iter().enumerate() {
+            if k == 70 {
+                w.set_fibres(vec![fibre]);
+            }
+            w.write_frame(f, None).unwrap();
+        }
+        assert_eq!(w.frames_written(), frames.len() as u64);
+        w.finish().unwrap();
+        std::fs::read(&path).unwrap()
+    };
+    let (queued, unqueued) = (write(true), write(false));
+    let (a, b) = (messages(&queued), messages(&unqueued));
+    assert_eq!(a.len(), 2 * frames.len());
+    assert!(a == b, "queued frames gave other messages");
+    // the fibres are drawn from frame 70 on, not before
+    let scene = |k: usize| &a[2 * k + 1].3;
+    assert!(scene(71).len() > scene(69).len());
 }

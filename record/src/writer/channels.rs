@@ -55,6 +55,7 @@ impl RecordingWriter {
                 detail: format!("topic {topic:?} is empty or already has a channel"),
             });
         }
+        self.drain_queue()?;
         let schema_id = if schema_encoding.is_empty() && schema_data.is_empty() {
             0
         } else {
@@ -121,6 +122,7 @@ impl RecordingWriter {
                 });
             }
         }
+        self.drain_queue()?;
         for &(channel, log_time, data) in messages {
             let added = &mut self.channels[channel.index];
             // MCAP sequence numbers are u32; wrapping after 2^32 messages is harmless.

@@ -2,6 +2,7 @@
 //! metadata records that plugins add.
 
 mod channels;
+mod queue;
 
 pub use channels::ChannelHandle;
 
@@ -19,6 +20,7 @@ use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
 use glam::DVec3;
 use mcap::records::{MessageHeader, Metadata};
+use queue::QueuedFrame;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -109,6 +111,13 @@ pub struct RecordingWriter {
     last_flush: Instant,
     /// When the last frame was written.
     last_frame: Option<Instant>,
+    /// Small frames not yet encoded (buffered writers only; see `queue.rs`).
+    queued: Vec<QueuedFrame>,
+    /// Particles in `queued`.
+    queued_particles: usize,
+    /// An error met while encoding queued frames in a call that cannot return it (the
+    /// `set_*` methods); the next fallible call returns it.
+    deferred_error: Option<RecordError>,
 }
 
 /// How long frames may wait in the open chunk (see [`RecordingWriter::buffer_frames`]).
@@ -177,6 +186,9 @@ impl RecordingWriter {
             pending: 0,
             last_flush: Instant::now(),
             last_frame: None,
+            queued: Vec::new(),
+            queued_particles: 0,
+            deferred_error: None,
         };
         let mut mcap = options
             .create(BufWriter::new(sink))
@@ -216,7 +228,9 @@ impl RecordingWriter {
     /// cost a fraction of the time. Every other write (metadata, channels,
     /// [`finish`](Self::finish), dropping the writer) still flushes at once, the pending frames
     /// included; a process killed without finishing loses only frames that came less than
-    /// `max_wait` after the last flush. `None` restores one chunk per frame (the default).
+    /// `max_wait` after the last flush. Small frames are also encoded in batches (see
+    /// `writer/queue.rs`; the file's bytes do not change), so an encoding error can be returned
+    /// by a later call than the frame's. `None` restores one chunk per frame (the default).
     pub fn buffer_frames(&mut self, policy: Option<FrameBuffering>) {
         self.buffering = policy;
     }
@@ -226,9 +240,9 @@ impl RecordingWriter {
         &self.path
     }
 
-    /// Number of frames written so far.
+    /// Number of frames written so far (those still queued for encoding included).
     pub fn frames_written(&self) -> u64 {
-        self.frames_written
+        self.frames_written + self.queued.len() as u64
     }
 
     /// Writes `frame` as one message on [`STATE_TOPIC`] and one on [`SCENE_TOPIC`], both with log
@@ -257,6 +271,25 @@ impl RecordingWriter {
                 ),
             });
         }
+        if let Some(e) = self.deferred_error.take() {
+            return Err(e);
+        }
+        if self.queue_frame(frame, colours, n) {
+            return self.after_frame();
+        }
+        self.drain_queue()?;
+        self.encode_frame(frame, colours)?;
+        self.after_frame()
+    }
+
+    /// Encode `frame` and write its two messages into the open chunk (ending the chunk first
+    /// if the frame would make it larger than readers accept); no flush.
+    fn encode_frame(
+        &mut self,
+        frame: &ParticleFrame,
+        colours: Option<&[[f32; 4]]>,
+    ) -> Result<(), RecordError> {
+        let n = frame.ids.len();
         let log_time = log_time_ns(frame).max(self.last_log_time.unwrap_or(0));
         // MCAP sequence numbers are u32; wrapping after 2^32 frames is harmless.
         let sequence = self.frames_written as u32;
@@ -291,17 +324,6 @@ impl RecordingWriter {
         self.buf = scene;
         self.write_buf(self.scene_channel, sequence, log_time)?;
         self.pending += chunk;
-        let now = Instant::now();
-        let slow = self.last_frame.is_none_or(|t| {
-            now.duration_since(t) >= self.buffering.map_or(Duration::ZERO, |b| b.max_wait)
-        });
-        self.last_frame = Some(now);
-        let due = self.buffering.is_none_or(|b| {
-            slow || self.pending >= b.max_bytes || now.duration_since(self.last_flush) >= b.max_wait
-        });
-        if due {
-            self.flush()?;
-        }
         self.last_log_time = Some(log_time);
         self.frames_written += 1;
         Ok(())
@@ -309,6 +331,7 @@ impl RecordingWriter {
 
     /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
     pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
+        self.drain_before_decor();
         self.decor.fibres = fibres;
         self.static_scene = None;
     }
@@ -318,11 +341,13 @@ impl RecordingWriter {
     /// `magsep_components::container::Walls`, whose serde form is the same; this keeps the codec
     /// free of ECS types). A value of another form draws no walls.
     pub fn set_walls<W: serde::Serialize>(&mut self, walls: Option<W>) {
+        self.drain_before_decor();
         self.decor.walls = walls.and_then(|w| WallShape::from_serialize(&w));
     }
 
     /// Boxes to draw behind the particles (entity `backdrop`) in every following scene update.
     pub fn set_backdrop(&mut self, cubes: Vec<BackdropCube>) {
+        self.drain_before_decor();
         self.decor.backdrop = cubes;
         self.static_scene = None;
     }
@@ -330,6 +355,7 @@ impl RecordingWriter {
     /// Superquadric semi-axes per particle (frame order; zero for spheres and rods): such
     /// particles are drawn as ellipsoids of these semi-axes.
     pub fn set_semi_axes(&mut self, semi_axes: Vec<DVec3>) {
+        self.drain_before_decor();
         self.decor.semi_axes = semi_axes;
     }
 
@@ -368,6 +394,7 @@ impl RecordingWriter {
     }
 
     fn finish_inner(mut self, sync: bool) -> Result<(), RecordError> {
+        self.drain_queue()?;
         let Some(mut mcap) = self.mcap.take() else {
             return Ok(());
         };
@@ -407,6 +434,7 @@ impl RecordingWriter {
         name: &str,
         entries: BTreeMap<String, String>,
     ) -> Result<(), RecordError> {
+        self.drain_queue()?;
         let metadata = Metadata {
             name: name.into(),
             metadata: entries,
@@ -448,6 +476,9 @@ impl Drop for RecordingWriter {
     /// Finishes the file best-effort if [`finish`](Self::finish) was not called; errors are
     /// ignored and nothing panics (the underlying `mcap::Writer` also finishes on drop).
     fn drop(&mut self) {
+        if self.mcap.is_some() {
+            let _ = self.drain_queue();
+        }
         if let Some(mut mcap) = self.mcap.take() {
             let _ = mcap.finish();
             // Dropping the BufWriter flushes it, ignoring errors.

@@ -228,7 +228,12 @@ impl Dynamics for PipelineDynamics<'_> {
 impl PipelineDynamics<'_> {
     /// Capture the free particles of `which` (ascending) whose path `from[i] → x[i]` comes
     /// within capture distance of a fibre: they stop at the capture point and are fixed.
-    fn capture_swept(&mut self, from: &[DVec3], x: &mut [DVec3], which: impl Iterator<Item = usize>) {
+    fn capture_swept(
+        &mut self,
+        from: &[DVec3],
+        x: &mut [DVec3],
+        which: impl Iterator<Item = usize>,
+    ) {
         if self.model.sources.is_empty() {
             return;
         }
