@@ -13,7 +13,7 @@
 //!
 //! | set | system | touches |
 //! |---|---|---|
-//! | `Record` | [`record_frame`] (exclusive) | `Recorder`; reads particles, `StepClock`, `Container`, the providers |
+//! | `Record` | [`record_frame`] (exclusive; runs only if [`frame_due`]) | `Recorder`; reads particles, `StepClock`, `Container`, the providers |
 
 use std::collections::BTreeMap;
 
@@ -137,7 +137,7 @@ impl SimPlugin for RecordPlugin {
         }
         app.world.init_resource::<FrameStatusProviders>();
         app.schedule
-            .add_systems(record_frame.in_set(SimSystems::Record));
+            .add_systems(record_frame.in_set(SimSystems::Record).run_if(frame_due));
     }
 }
 
@@ -219,6 +219,14 @@ pub fn record_now(world: &mut World) {
         t.seconds += started.elapsed().as_secs_f64();
         t.frames += 1;
     }
+}
+
+/// Whether this step's frame is due (the run condition of [`record_frame`], which as an
+/// exclusive system would otherwise take the whole world at every step just to find out).
+pub fn frame_due(clock: Option<Res<StepClock>>, recorder: Option<Res<Recorder>>) -> bool {
+    recorder.is_some_and(|r| {
+        r.writer.is_some() && clock.is_some_and(|c| c.step.is_multiple_of(r.every.max(1)))
+    })
 }
 
 /// Record: write a frame every `every` steps.
