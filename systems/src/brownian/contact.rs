@@ -42,8 +42,61 @@ pub fn swept_capture(
     x1: DVec3,
     a: f64,
 ) -> Option<(usize, DVec3)> {
+    swept_capture_gap(fibres, x0, x1, a).0
+}
+
+/// A lower bound `gap` of a particle's gap (distance to the nearest fibre minus its radius)
+/// at the position `at` \[m\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GapBound {
+    /// Where the bound holds \[m\].
+    pub at: DVec3,
+    /// The bound \[m\].
+    pub gap: f64,
+}
+
+/// [`swept_capture`] with a memo of the particle's gap: when `bound` holds at `x0` and exceeds
+/// the segment's length, the segment cannot touch a fibre (the gap is 1-Lipschitz), so
+/// nothing is computed and the bound moves to `x1` reduced by the length; otherwise the exact
+/// search runs and leaves the exact gap at `x1` (or `None` after a capture). The result is
+/// that of [`swept_capture`]. Far from the fibres this skips almost every distance evaluation.
+pub fn swept_capture_cached(
+    fibres: &[CylinderSource],
+    x0: DVec3,
+    x1: DVec3,
+    a: f64,
+    bound: &mut Option<GapBound>,
+) -> Option<(usize, DVec3)> {
+    let len = (x1 - x0).length();
+    if let Some(b) = *bound
+        && b.at == x0
+        && b.gap - len > 0.0
+    {
+        *bound = Some(GapBound {
+            at: x1,
+            gap: b.gap - len,
+        });
+        return None;
+    }
+    let (hit, gap) = swept_capture_gap(fibres, x0, x1, a);
+    *bound = match hit {
+        None if gap.is_finite() => Some(GapBound { at: x1, gap }),
+        _ => None,
+    };
+    hit
+}
+
+/// [`swept_capture`], and the exact gap at `x1` (the smallest over the fibres; meaningful
+/// only when nothing is captured; infinite without fibres).
+fn swept_capture_gap(
+    fibres: &[CylinderSource],
+    x0: DVec3,
+    x1: DVec3,
+    a: f64,
+) -> (Option<(usize, DVec3)>, f64) {
     let len = (x1 - x0).length();
     let mut best: Option<(f64, usize)> = None;
+    let mut end_gap = f64::INFINITY;
     for (k, f) in fibres.iter().enumerate() {
         let gap = |s: f64| f.distance(x0 + (x1 - x0) * s) - a;
         let g0 = gap(0.0);
@@ -52,6 +105,7 @@ pub fn swept_capture(
             break;
         }
         let g1 = gap(1.0);
+        end_gap = end_gap.min(g1);
         if g1 > 0.0 && 0.5 * (g0 + g1 - len) > 0.0 {
             continue;
         }
@@ -81,7 +135,9 @@ pub fn swept_capture(
             stack.push((s0, sm, d0, dm));
         }
     }
-    let (s, k) = best?;
+    let Some((s, k)) = best else {
+        return (None, end_gap);
+    };
     let p = x0 + (x1 - x0) * s;
     // snap onto the contact sphere: distance exactly a along the normal
     let c = fibres[k].closest_point(p);
@@ -91,7 +147,7 @@ pub fn swept_capture(
     } else {
         p
     };
-    Some((k, p))
+    (Some((k, p)), end_gap)
 }
 
 /// Push overlapping pairs apart (see the module header). `mobile[i]` particles move; pairs of
@@ -151,6 +207,55 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
+
+    #[test]
+    fn the_gap_memo_changes_no_capture_and_skips_far_segments() {
+        // random walks (steps of 0.02-0.2) from far away towards two fibres: the cached search
+        // returns what the plain one does at every step, and far from the fibres it computes
+        // nothing (its bound drops by exactly the step length)
+        let fibres = [
+            CylinderSource::new(DVec3::ZERO, DVec3::Z, 1.0, 2.0, DVec3::ZERO),
+            CylinderSource::new(DVec3::new(3.0, 0.0, 0.0), DVec3::X, 0.5, 1.0, DVec3::ZERO),
+        ];
+        let a = 0.05;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let (mut skipped, mut captured) = (0, 0);
+        for walk in 0..60 {
+            let mut x = DVec3::new(8.0, 6.0 - 0.2 * walk as f64, 4.0);
+            let mut bound = None;
+            for _ in 0..400 {
+                let step = 0.02 + 0.18 * rng.random::<f64>();
+                let dir = (DVec3::new(1.5, 0.0, 0.0) - x).normalize_or_zero()
+                    + DVec3::new(rng.random(), rng.random(), rng.random())
+                    - 0.5;
+                let x1 = x + dir.normalize_or_zero() * step;
+                let before = bound;
+                let cached = swept_capture_cached(&fibres, x, x1, a, &mut bound);
+                assert_eq!(cached, swept_capture(&fibres, x, x1, a));
+                if let Some(b) = before
+                    && b.at == x
+                    && b.gap > (x1 - x).length()
+                {
+                    skipped += 1;
+                    assert_eq!(bound.unwrap().gap, b.gap - (x1 - x).length());
+                    let exact = fibres
+                        .iter()
+                        .map(|f| f.distance(x1) - a)
+                        .fold(f64::MAX, f64::min);
+                    assert!(bound.unwrap().gap <= exact, "the bound exceeds the gap");
+                }
+                if let Some((_, p)) = cached {
+                    captured += 1;
+                    assert!(bound.is_none());
+                    x = p;
+                    break;
+                }
+                x = x1;
+            }
+        }
+        assert!(skipped > 1000, "skipped {skipped}");
+        assert!(captured > 20, "captured {captured}");
+    }
 
     #[test]
     fn capture_finds_grazing_and_end_face_contacts() {

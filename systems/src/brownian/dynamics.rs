@@ -9,7 +9,7 @@ use magsep_components::shape::Shape;
 
 use crate::forces::{ExternalForces, ParticleState};
 
-use super::contact::{remove_overlaps, swept_capture};
+use super::contact::{remove_overlaps, swept_capture_cached};
 use super::hydro::Mobility;
 use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
 use super::stepper::Dynamics;
@@ -237,11 +237,14 @@ impl PipelineDynamics<'_> {
         if self.model.sources.is_empty() {
             return;
         }
+        let gaps = &mut self.lists.capture_gaps;
+        gaps.resize(x.len(), None);
         for i in which {
             if !self.mobile[i] {
                 continue;
             }
-            if let Some((k, p)) = swept_capture(&self.model.sources, from[i], x[i], self.radii[i]) {
+            let (sources, a) = (&self.model.sources, self.radii[i]);
+            if let Some((k, p)) = swept_capture_cached(sources, from[i], x[i], a, &mut gaps[i]) {
                 x[i] = p;
                 self.mobile[i] = false;
                 self.captures.push((

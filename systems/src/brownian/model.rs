@@ -78,6 +78,9 @@ pub struct PairLists {
     pub contact: VerletList,
     /// Field-patch memos (used when the model has a patch size).
     pub patches: FieldPatches,
+    /// Per particle, a lower bound of its gap to the fibres where it last moved (the capture
+    /// search's memo, see [`swept_capture_cached`](super::contact::swept_capture_cached)).
+    pub capture_gaps: Vec<Option<super::contact::GapBound>>,
 }
 
 impl PairLists {
