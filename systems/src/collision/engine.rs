@@ -148,20 +148,10 @@ pub struct CollisionEngine {
     rest_partners: Vec<u32>,
     /// Bounding radii of this step (the radii for spheres).
     radius: Vec<f64>,
-    /// Bodies of the fast resting sweeps.
-    bodies: Vec<resting_fast::Body>,
-    /// Per resting contact, its convergence threshold [m/s].
-    scale: Vec<f64>,
+    /// Scratch of the fast kernels.
+    fast: resting_fast::Scratch,
     /// Use the plain reference kernels instead of the fast ones (tests compare the two).
     reference: bool,
-    /// Evaluation counter of the projection's fast sweeps.
-    stamp: u64,
-    /// Per particle, the stamp of its last projection move.
-    moved: Vec<u64>,
-    /// Per candidate slot, the stamp of the last evaluation that found the pair apart.
-    pair_apart: Vec<u64>,
-    /// Per particle and wall, the stamp of the last evaluation that found them apart.
-    wall_apart: Vec<u64>,
 }
 
 impl CollisionEngine {
@@ -189,12 +179,6 @@ impl CollisionEngine {
             (Some(&a), Some(&b)) => &self.rest_partners[a..b],
             _ => &[],
         }
-    }
-
-    /// Switches to the plain reference kernels (tests check the fast ones against them).
-    #[cfg(test)]
-    pub(crate) fn use_reference_kernels(&mut self, on: bool) {
-        self.reference = on;
     }
 
     /// Forgets the resting-contact impulses kept for the warm start (call it when the particle

@@ -47,12 +47,12 @@ impl Sim<'_, '_> {
 
     /// Clears the stamps of the fast sweeps (every pair is evaluated in the first sweep).
     fn reset_stamps(&mut self) {
-        let e = &mut *self.eng;
+        let e = &mut self.eng.fast;
         e.stamp = 0;
         e.moved.clear();
         e.moved.resize(self.p.positions.len(), 0);
         e.pair_apart.clear();
-        e.pair_apart.resize(e.candidates.total(), 0);
+        e.pair_apart.resize(self.eng.candidates.total(), 0);
         e.wall_apart.clear();
         e.wall_apart
             .resize(self.p.positions.len() * self.domain.planes.len(), 0);
@@ -81,16 +81,16 @@ impl Sim<'_, '_> {
                 if j <= i {
                     continue;
                 }
-                let e = &*self.eng;
+                let e = &self.eng.fast;
                 let apart = e.pair_apart[slot];
                 if apart > e.moved[i] && apart > e.moved[j] {
                     continue; // apart when last seen, and neither has moved since
                 }
-                self.eng.stamp += 1;
+                self.eng.fast.stamp += 1;
                 let before = (self.p.positions[i], self.p.positions[j]);
                 let o = self.separate(i, j, fix);
                 worst = worst.max(o);
-                let e = &mut *self.eng;
+                let e = &mut self.eng.fast;
                 if o > 0.0 {
                     if (self.p.positions[i], self.p.positions[j]) != before {
                         e.moved[i] = e.stamp;
@@ -117,11 +117,11 @@ impl Sim<'_, '_> {
             let i = if backward { n - 1 - k } else { k };
             for p in 0..planes {
                 let slot = i * planes + p;
-                let e = &*self.eng;
+                let e = &self.eng.fast;
                 if e.wall_apart[slot] > e.moved[i] {
                     continue;
                 }
-                self.eng.stamp += 1;
+                self.eng.fast.stamp += 1;
                 let plane = self.domain.planes[p];
                 let x = self.p.positions[i];
                 let overlap = if self.p.spheroids.is_none() {
@@ -130,14 +130,14 @@ impl Sim<'_, '_> {
                     -self.wall_contact(i, x, h, &plane).gap
                 };
                 if overlap <= 0.0 || overlap.is_nan() {
-                    self.eng.wall_apart[slot] = self.eng.stamp;
+                    self.eng.fast.wall_apart[slot] = self.eng.fast.stamp;
                     continue;
                 }
                 worst = worst.max(overlap / (2.0 * self.eng.radius[i]));
                 if fix && self.p.inv_masses[i] > 0.0 {
                     self.p.positions[i] += plane.normal * overlap;
                     if self.p.positions[i] != x {
-                        self.eng.moved[i] = self.eng.stamp;
+                        self.eng.fast.moved[i] = self.eng.fast.stamp;
                     }
                 }
             }

@@ -238,7 +238,7 @@ impl Sim<'_, '_> {
         mu: f64,
     ) -> (usize, f64) {
         let n = self.n();
-        let mut bodies = std::mem::take(&mut self.eng.bodies);
+        let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
         bodies.clear();
         bodies.extend((0..n).map(|i| Body {
             v: self.p.velocities[i],
@@ -246,7 +246,7 @@ impl Sim<'_, '_> {
             inv_mass: self.p.inv_masses[i],
             inv_inertia: inv_inertia[i],
         }));
-        let mut scale = std::mem::take(&mut self.eng.scale);
+        let mut scale = std::mem::take(&mut self.eng.fast.scale);
         scale.clear();
         let r = &self.eng.radius;
         scale.extend(contacts.iter().map(|c| {
@@ -260,14 +260,19 @@ impl Sim<'_, '_> {
             self.p.velocities[i] = b.v;
             self.p.angular_velocities[i] = b.w;
         }
-        self.eng.bodies = bodies;
-        self.eng.scale = scale;
+        self.eng.fast.bodies = bodies;
+        self.eng.fast.scale = scale;
         out
     }
 
     /// The plain projected Gauss–Seidel sweeps (the reference of [`Self::resting_sweeps_fast`]); returns
     /// the sweeps done and the residual.
-    fn resting_sweeps_reference(&mut self, contacts: &mut [Contact], tol: f64, mu: f64) -> (usize, f64) {
+    fn resting_sweeps_reference(
+        &mut self,
+        contacts: &mut [Contact],
+        tol: f64,
+        mu: f64,
+    ) -> (usize, f64) {
         let n = self.n();
         let mut sweeps = 0;
         let mut residual = 0.0;

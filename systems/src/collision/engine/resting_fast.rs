@@ -11,6 +11,23 @@ use glam::DVec3;
 
 use super::resting::Contact;
 
+/// Scratch buffers of the fast kernels (kept between steps).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Scratch {
+    /// Bodies of the fast resting sweeps.
+    pub(super) bodies: Vec<Body>,
+    /// Per resting contact, its convergence threshold [m/s].
+    pub(super) scale: Vec<f64>,
+    /// Evaluation counter of the projection's fast sweeps.
+    pub(super) stamp: u64,
+    /// Per particle, the stamp of its last projection move.
+    pub(super) moved: Vec<u64>,
+    /// Per candidate slot, the stamp of the last evaluation that found the pair apart.
+    pub(super) pair_apart: Vec<u64>,
+    /// Per particle and wall, the stamp of the last evaluation that found them apart.
+    pub(super) wall_apart: Vec<u64>,
+}
+
 /// One particle in the fast sweeps.
 #[derive(Debug, Clone, Copy, Default)]
 #[repr(C, align(64))]

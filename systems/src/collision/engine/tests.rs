@@ -472,7 +472,7 @@ fn fast_kernels_match_the_reference_kernels_bitwise() {
     };
     let mut fast = CollisionEngine::new(EngineConfig::default());
     let mut reference = CollisionEngine::new(EngineConfig::default());
-    reference.use_reference_kernels(true);
+    reference.reference = true;
     let mut total = CollisionStats::default();
     for step in 0..160 {
         for s in [&mut a, &mut b] {
@@ -492,5 +492,8 @@ fn fast_kernels_match_the_reference_kernels_bitwise() {
     // the comparison covered every kernel
     assert!(total.events > 1000, "{total:?}");
     assert!(total.resting_contacts > 1000, "{total:?}");
-    assert!(total.resting_sweeps > 3 && total.projection_sweeps > 3, "{total:?}");
+    assert!(
+        total.resting_sweeps > 3 && total.projection_sweeps > 3,
+        "{total:?}"
+    );
 }
