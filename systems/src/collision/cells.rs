@@ -101,6 +101,22 @@ impl Candidates {
         &self.partners[self.offsets[i]..self.offsets[i + 1]]
     }
 
+    /// Positions of particle `i`'s candidates in the flat list of all candidates (`0..`[`Self::total`]).
+    pub fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i]..self.offsets[i + 1]
+    }
+
+    /// Candidate at position `k` of the flat list.
+    #[inline]
+    pub fn at(&self, k: usize) -> u32 {
+        self.partners[k]
+    }
+
+    /// Length of the flat list of all candidates.
+    pub fn total(&self) -> usize {
+        self.partners.len()
+    }
+
     /// Rebuilds the lists for start positions `x` [m], radii [m] and `reach` [m] (see the module
     /// header).
     pub fn build(&mut self, x: &[DVec3], radii: &[f64], domain: &CollisionDomain, reach: f64) {

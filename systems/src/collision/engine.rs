@@ -94,6 +94,7 @@ use event::Event;
 mod event;
 mod projection;
 mod resting;
+mod resting_fast;
 mod shapes;
 mod types;
 
@@ -147,6 +148,10 @@ pub struct CollisionEngine {
     rest_partners: Vec<u32>,
     /// Bounding radii of this step (the radii for spheres).
     radius: Vec<f64>,
+    /// Scratch of the fast kernels.
+    fast: resting_fast::Scratch,
+    /// Use the plain reference kernels instead of the fast ones (tests compare the two).
+    reference: bool,
 }
 
 impl CollisionEngine {

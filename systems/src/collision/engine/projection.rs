@@ -6,6 +6,12 @@
 //! last, ends the projection when the budget allows, so that no particle is left in a wall.
 //! Pairs with a spheroid are pushed apart along their contact normal by the penetration depth,
 //! a spheroid out of a wall along the wall normal (translations only; orientations are kept).
+//!
+//! Fast path: a pair (or particle–wall pair) that was found apart, and neither of whose
+//! particles has moved since, is apart again, so the sweeps skip it (every evaluation is a pure
+//! function of the two positions). Per-particle stamps of the last move and per-pair stamps of
+//! the last evaluation that found the pair apart decide it. The result is bitwise that of the
+//! plain sweeps (`sweep_reference`, kept for the tests), which visit every pair every time.
 
 use glam::DVec3;
 
@@ -14,6 +20,7 @@ use super::Sim;
 impl Sim<'_, '_> {
     /// Overlap-projection sweeps (see the module header); records the largest overlaps.
     pub(super) fn project(&mut self) {
+        self.reset_stamps();
         let max = self.cfg.projection_sweeps as usize;
         let before = self.sweep(max > 0, false);
         let mut worst = before;
@@ -38,10 +45,109 @@ impl Sim<'_, '_> {
         st.max_overlap_after_projection = after;
     }
 
+    /// Clears the stamps of the fast sweeps (every pair is evaluated in the first sweep).
+    fn reset_stamps(&mut self) {
+        let e = &mut self.eng.fast;
+        e.stamp = 0;
+        e.moved.clear();
+        e.moved.resize(self.p.positions.len(), 0);
+        e.pair_apart.clear();
+        e.pair_apart.resize(self.eng.candidates.total(), 0);
+        e.wall_apart.clear();
+        e.wall_apart
+            .resize(self.p.positions.len() * self.domain.planes.len(), 0);
+    }
+
     /// One pass over all candidate pairs and walls (forward: pairs in index order, then walls;
     /// backward: walls, then pairs in reverse order); returns the largest relative overlap seen
-    /// (before each correction) and corrects if `fix`.
+    /// (before each correction) and corrects if `fix`. Skips the pairs known to be apart (see
+    /// the module header); bitwise equal to [`Self::sweep_reference`].
     fn sweep(&mut self, fix: bool, backward: bool) -> f64 {
+        if self.eng.reference {
+            return self.sweep_reference(fix, backward);
+        }
+        let n = self.n();
+        let mut worst = 0.0f64;
+        if backward {
+            worst = worst.max(self.sweep_walls_fast(fix, true));
+        }
+        for k in 0..n {
+            let i = if backward { n - 1 - k } else { k };
+            let range = self.eng.candidates.range(i);
+            let (a, b) = (range.start, range.end);
+            for q in 0..b - a {
+                let slot = if backward { b - 1 - q } else { a + q };
+                let j = self.eng.candidates.at(slot) as usize;
+                if j <= i {
+                    continue;
+                }
+                let e = &self.eng.fast;
+                let apart = e.pair_apart[slot];
+                if apart > e.moved[i] && apart > e.moved[j] {
+                    continue; // apart when last seen, and neither has moved since
+                }
+                self.eng.fast.stamp += 1;
+                let before = (self.p.positions[i], self.p.positions[j]);
+                let o = self.separate(i, j, fix);
+                worst = worst.max(o);
+                let e = &mut self.eng.fast;
+                if o > 0.0 {
+                    if (self.p.positions[i], self.p.positions[j]) != before {
+                        e.moved[i] = e.stamp;
+                        e.moved[j] = e.stamp;
+                    }
+                } else {
+                    e.pair_apart[slot] = e.stamp;
+                }
+            }
+        }
+        if !backward {
+            worst = worst.max(self.sweep_walls_fast(fix, false));
+        }
+        worst
+    }
+
+    /// [`Self::sweep_walls`] with the stamps of [`Self::sweep`].
+    fn sweep_walls_fast(&mut self, fix: bool, backward: bool) -> f64 {
+        let mut worst = 0.0f64;
+        let n = self.p.positions.len();
+        let h = self.h;
+        let planes = self.domain.planes.len();
+        for k in 0..n {
+            let i = if backward { n - 1 - k } else { k };
+            for p in 0..planes {
+                let slot = i * planes + p;
+                let e = &self.eng.fast;
+                if e.wall_apart[slot] > e.moved[i] {
+                    continue;
+                }
+                self.eng.fast.stamp += 1;
+                let plane = self.domain.planes[p];
+                let x = self.p.positions[i];
+                let overlap = if self.p.spheroids.is_none() {
+                    self.eng.radius[i] - plane.signed_distance(x)
+                } else {
+                    -self.wall_contact(i, x, h, &plane).gap
+                };
+                if overlap <= 0.0 || overlap.is_nan() {
+                    self.eng.fast.wall_apart[slot] = self.eng.fast.stamp;
+                    continue;
+                }
+                worst = worst.max(overlap / (2.0 * self.eng.radius[i]));
+                if fix && self.p.inv_masses[i] > 0.0 {
+                    self.p.positions[i] += plane.normal * overlap;
+                    if self.p.positions[i] != x {
+                        self.eng.fast.moved[i] = self.eng.fast.stamp;
+                    }
+                }
+            }
+        }
+        worst
+    }
+
+    /// The plain sweep: every candidate pair and wall, every time (the reference of
+    /// [`Self::sweep`]).
+    fn sweep_reference(&mut self, fix: bool, backward: bool) -> f64 {
         let n = self.n();
         let mut worst = 0.0f64;
         if backward {

@@ -21,6 +21,7 @@
 
 use glam::DVec3;
 
+use super::resting_fast::{self, Body};
 use super::{CollisionEvent, FrictionRegime, InverseInertia, LastCollision, Partner, Sim};
 use crate::collision::impulse::RigidBody;
 use crate::collision::toi::ContactGeometry;
@@ -37,18 +38,18 @@ pub(super) struct Cached {
 /// One resting contact during the solve (compact: the sweeps are memory bound).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Contact {
-    i: u32,
-    j: u32,
-    normal: DVec3,
-    r_a: DVec3,
-    r_b: DVec3,
-    m_n: f64,
-    bias: f64,
-    approach: f64,
+    pub(super) i: u32,
+    pub(super) j: u32,
+    pub(super) normal: DVec3,
+    pub(super) r_a: DVec3,
+    pub(super) r_b: DVec3,
+    pub(super) m_n: f64,
+    pub(super) bias: f64,
+    pub(super) approach: f64,
     /// Distance of the contact point from the nearest wall (sweep order) [m].
-    depth: f64,
-    lambda_n: f64,
-    lambda_t: DVec3,
+    pub(super) depth: f64,
+    pub(super) lambda_n: f64,
+    pub(super) lambda_t: DVec3,
 }
 
 impl Contact {
@@ -216,6 +217,63 @@ impl Sim<'_, '_> {
                 .then((a.i, a.j).cmp(&(b.i, b.j)))
         });
         let tol = self.cfg.resting_tolerance / self.h;
+        let (sweeps, residual) = match self.p.inv_inertias {
+            InverseInertia::Scalar(s) if !self.eng.reference => {
+                self.resting_sweeps_fast(&mut contacts, s, tol, mu)
+            }
+            _ => self.resting_sweeps_reference(&mut contacts, tol, mu),
+        };
+        self.finish_resting(&contacts, sweeps, residual);
+        self.index_resting(&contacts);
+        self.eng.contacts = contacts;
+    }
+
+    /// The sweeps on a compact copy of the bodies ([`super::resting_fast`]); bitwise equal to
+    /// [`Self::resting_sweeps_reference`] for isotropic inertias `inv_inertia`.
+    fn resting_sweeps_fast(
+        &mut self,
+        contacts: &mut [Contact],
+        inv_inertia: &[f64],
+        tol: f64,
+        mu: f64,
+    ) -> (usize, f64) {
+        let n = self.n();
+        let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
+        bodies.clear();
+        bodies.extend((0..n).map(|i| Body {
+            v: self.p.velocities[i],
+            w: self.p.angular_velocities[i],
+            inv_mass: self.p.inv_masses[i],
+            inv_inertia: inv_inertia[i],
+        }));
+        let mut scale = std::mem::take(&mut self.eng.fast.scale);
+        scale.clear();
+        let r = &self.eng.radius;
+        scale.extend(contacts.iter().map(|c| {
+            let (i, j) = c.ij();
+            let s = if j < n { r[i] + r[j] } else { 2.0 * r[i] };
+            tol * s
+        }));
+        let max = self.cfg.resting_sweeps as usize;
+        let out = resting_fast::sweeps(contacts, &mut bodies, &scale, n, mu, max);
+        for (i, b) in bodies.iter().enumerate() {
+            self.p.velocities[i] = b.v;
+            self.p.angular_velocities[i] = b.w;
+        }
+        self.eng.fast.bodies = bodies;
+        self.eng.fast.scale = scale;
+        out
+    }
+
+    /// The plain projected Gauss–Seidel sweeps (the reference of [`Self::resting_sweeps_fast`]); returns
+    /// the sweeps done and the residual.
+    fn resting_sweeps_reference(
+        &mut self,
+        contacts: &mut [Contact],
+        tol: f64,
+        mu: f64,
+    ) -> (usize, f64) {
+        let n = self.n();
         let mut sweeps = 0;
         let mut residual = 0.0;
         while sweeps < self.cfg.resting_sweeps as usize {
@@ -241,9 +299,7 @@ impl Sim<'_, '_> {
                 break;
             }
         }
-        self.finish_resting(&contacts, sweeps, residual);
-        self.index_resting(&contacts);
-        self.eng.contacts = contacts;
+        (sweeps, residual)
     }
 
     /// One projected Gauss–Seidel update of contact `c` (normal, then friction); returns the
