@@ -47,16 +47,20 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
     let axis = &sweep.axes[a];
     let xs: Option<Vec<f64>> = axis.values.iter().map(value_number).collect();
     let xs = xs?;
-    // series key: the value indices of the other axes
+    // series key: the value indices of the other axes (not those zipped with `a`)
+    let group = (sweep.groups.iter())
+        .find(|g| g.contains(&a))
+        .cloned()
+        .unwrap_or_else(|| vec![a]);
+    let others: Vec<usize> = (0..sweep.axes.len())
+        .filter(|k| !group.contains(k))
+        .collect();
     let mut series: BTreeMap<Vec<usize>, BTreeMap<usize, Vec<f64>>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.status == "ok") {
         let Some(y) = r.number(c).filter(|y| y.is_finite()) else {
             continue;
         };
-        let key: Vec<usize> = (0..sweep.axes.len())
-            .filter(|&k| k != a)
-            .map(|k| r.values[k])
-            .collect();
+        let key: Vec<usize> = others.iter().map(|&k| r.values[k]).collect();
         series
             .entry(key)
             .or_default()
@@ -75,7 +79,6 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
     .x_label(label(&axis.name, axis.unit.as_deref()))
     .y_label(c_name.clone())
     .x_log(axis.log);
-    let others: Vec<usize> = (0..sweep.axes.len()).filter(|&k| k != a).collect();
     for (key, by_x) in series {
         let name = if others.is_empty() {
             c_name.clone()

@@ -14,6 +14,8 @@ pub mod file;
 pub mod run;
 pub mod slurm;
 pub mod table;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
