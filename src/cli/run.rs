@@ -80,7 +80,11 @@ fn parse_with_overrides(
     text: &str,
     overrides: Vec<String>,
 ) -> Result<Scene, CliError> {
-    let what = if overrides.is_empty() { "" } else { " with --set" };
+    let what = if overrides.is_empty() {
+        ""
+    } else {
+        " with --set"
+    };
     let mut scene = parse_scene(text, &ext.registry)
         .map_err(|e| CliError::input(format!("{}{what} is invalid:\n{e}", path.display())))?;
     scene.overrides = overrides;

@@ -118,13 +118,15 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 cpus_per_task,
                 record,
             };
-            let result = sweep::write_slurm(&path, &out, &exe, &options, &ext.registry)
-                .map_err(to_cli)?;
+            let result =
+                sweep::write_slurm(&path, &out, &exe, &options, &ext.registry).map_err(to_cli)?;
             print(pretty(&result))
         }
         None => {
             let (Some(path), Some(out)) = (cmd.sweep, cmd.out) else {
-                return Err(CliError::input("magsep sweep needs SWEEP.toml and --out DIR"));
+                return Err(CliError::input(
+                    "magsep sweep needs SWEEP.toml and --out DIR",
+                ));
             };
             check_dir("--out", &out)?;
             let shard = cmd
@@ -157,8 +159,8 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 shard,
                 retry_failed: cmd.retry_failed,
             };
-            let result =
-                sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), &bar).map_err(to_cli)?;
+            let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), &bar)
+                .map_err(to_cli)?;
             print(pretty(&result))?;
             let failed = result["failed"]
                 .as_u64()

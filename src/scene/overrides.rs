@@ -357,7 +357,10 @@ pub fn apply_to_document(doc: &mut DocumentMut, ov: &Override) -> Result<(), Sce
                 )));
             }
             (Node::Table(_) | Node::Inline(_), Segment::Index(_)) => {
-                return Err(fail(format!("`{}` is a table, not an array", path.prefix(k))));
+                return Err(fail(format!(
+                    "`{}` is a table, not an array",
+                    path.prefix(k)
+                )));
             }
             (Node::Leaf(kind), _) => {
                 return Err(fail(format!(

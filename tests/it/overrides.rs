@@ -66,7 +66,10 @@ fn bad_overrides_give_exit_2_and_the_key_path() {
     let cases = [
         ("brownian.duration=-1.0", "brownian.duration:"),
         ("brownian.durration=1.0", "brownian.durration:"),
-        ("particles[0].shape.radius=fire", "particles[0].shape.radius:"),
+        (
+            "particles[0].shape.radius=fire",
+            "particles[0].shape.radius:",
+        ),
         ("particles[3].count=1", "particles[3]:"),
         ("simulation.seed.x=1", "simulation.seed.x:"),
         ("particles[0].count=[1,", "particles[0].count:"),
@@ -76,7 +79,12 @@ fn bad_overrides_give_exit_2_and_the_key_path() {
     for (arg, key) in cases {
         for cmd in ["validate", "run"] {
             let o = magsep(&[cmd, s, "--set", arg, "--quiet"][..if cmd == "run" { 5 } else { 4 }]);
-            assert_eq!(o.status.code(), Some(2), "{cmd} --set {arg}: {}", stderr(&o));
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "{cmd} --set {arg}: {}",
+                stderr(&o)
+            );
             let e = stderr(&o);
             assert!(e.contains(key), "{cmd} --set {arg}: {e}");
             assert!(!e.contains("panicked"), "{e}");

@@ -27,7 +27,9 @@ fn json(o: &Output) -> Value {
 
 /// A fresh directory for test `name`, with the base scene `base.toml` in it.
 fn fresh(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweeps").join(name);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("sweeps")
+        .join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("base.toml"), TRIVIAL).unwrap();
@@ -71,7 +73,10 @@ fn reference(dir: &Path, sweep: &str) -> String {
     let o = magsep(&["sweep", sweep, "--out", &out(dir, "whole"), "--quiet"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v = json(&o);
-    assert_eq!((v["points"].as_u64(), v["ok"].as_u64()), (Some(24), Some(24)));
+    assert_eq!(
+        (v["points"].as_u64(), v["ok"].as_u64()),
+        (Some(24), Some(24))
+    );
     assert_eq!(v["collected_values_absent"]["no_such_value"], 24);
     csv(&out(dir, "whole"))
 }
@@ -92,7 +97,11 @@ fn sweep_table_has_one_row_per_point_with_seeds_and_charts() {
     assert!(lines[1].starts_with("0,5e-8,0.01,0,100,"), "{}", lines[1]);
     assert!(lines[4].starts_with("3,5e-8,0.01,3,103,"), "{}", lines[4]);
     assert!(lines[5].starts_with("4,5e-8,0.02,0,100,"), "{}", lines[5]);
-    assert!(lines[24].starts_with("23,2e-7,0.02,3,103,"), "{}", lines[24]);
+    assert!(
+        lines[24].starts_with("23,2e-7,0.02,3,103,"),
+        "{}",
+        lines[24]
+    );
     // the duration axis is applied: 10 or 20 steps of 1 ms
     for l in &lines[1..] {
         let cells: Vec<&str> = l.split(',').collect();
@@ -128,7 +137,10 @@ fn a_killed_sweep_restarted_redoes_only_unfinished_points() {
         TRIVIAL.replace("time_step = 1e-3", "time_step = 1e-5"),
     )
     .unwrap();
-    let sweep = write_sweep(&dir, &SWEEP.replace("values = [1e-2, 2e-2]", "values = [5e-3, 1e-2]"));
+    let sweep = write_sweep(
+        &dir,
+        &SWEEP.replace("values = [1e-2, 2e-2]", "values = [5e-3, 1e-2]"),
+    );
     let whole = out(&dir, "whole");
     let o = magsep(&["sweep", &sweep, "--out", &whole, "--quiet"]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -179,13 +191,20 @@ fn a_killed_sweep_restarted_redoes_only_unfinished_points() {
     assert_eq!(v["skipped"].as_u64(), Some(kept.len() as u64), "{v}");
     assert_eq!(v["ran"].as_u64(), Some(24 - kept.len() as u64), "{v}");
     for (n, t) in &kept {
-        assert_eq!(mtime(&points.join(n).join("summary.json")), *t, "point {n} was redone");
+        assert_eq!(
+            mtime(&points.join(n).join("summary.json")),
+            *t,
+            "point {n} was redone"
+        );
     }
     assert!(!stale.exists());
     assert_eq!(csv(&killed), csv(&whole));
     // a third run has nothing left to do
     let v = json(&magsep(&["sweep", &sweep, "--out", &killed, "--quiet"]));
-    assert_eq!((v["ran"].as_u64(), v["skipped"].as_u64()), (Some(0), Some(24)));
+    assert_eq!(
+        (v["ran"].as_u64(), v["skipped"].as_u64()),
+        (Some(0), Some(24))
+    );
 }
 
 #[test]
@@ -200,7 +219,9 @@ fn shards_merged_equal_the_unsharded_sweep_and_partial_merges_work() {
     let mut ran = 0;
     for i in 1..=5 {
         let shard = format!("{i}/5");
-        let o = magsep(&["sweep", &sweep, "--out", &sharded, "--shard", &shard, "--quiet"]);
+        let o = magsep(&[
+            "sweep", &sweep, "--out", &sharded, "--shard", &shard, "--quiet",
+        ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let v = json(&o);
         ran += v["ran"].as_u64().unwrap();
@@ -215,7 +236,10 @@ fn shards_merged_equal_the_unsharded_sweep_and_partial_merges_work() {
             let o = magsep(&["sweep", "merge", &sharded]);
             assert!(o.status.success(), "{}", stderr(&o));
             let m = json(&o);
-            assert_eq!((m["ok"].as_u64(), m["missing"].as_u64()), (Some(5), Some(19)));
+            assert_eq!(
+                (m["ok"].as_u64(), m["missing"].as_u64()),
+                (Some(5), Some(19))
+            );
             assert!(stderr(&o).contains("19 of 24"), "{}", stderr(&o));
             let partial = csv(&sharded);
             assert_eq!(partial.matches(",missing,").count(), 19);
@@ -226,7 +250,11 @@ fn shards_merged_equal_the_unsharded_sweep_and_partial_merges_work() {
     let o = magsep(&["sweep", "merge", &sharded]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&o)["missing"], 0);
-    assert_eq!(csv(&sharded), whole, "shards merged differ from the unsharded sweep");
+    assert_eq!(
+        csv(&sharded),
+        whole,
+        "shards merged differ from the unsharded sweep"
+    );
     // bad shard specs
     for bad in ["0/3", "4/3", "1/0", "x", "1-3"] {
         let o = magsep(&["sweep", &sweep, "--out", &sharded, "--shard", bad]);
@@ -247,12 +275,26 @@ fn slurm_scripts_run_task_by_task_equal_the_local_sweep() {
     let whole = reference(&dir, &sweep);
     let cluster = out(&dir, "cluster");
     let o = magsep(&[
-        "sweep", "slurm", &sweep, "--out", &cluster, "--shards", "3", "--partition", "debug",
-        "--time", "00:10:00", "--cpus-per-task", "2",
+        "sweep",
+        "slurm",
+        &sweep,
+        "--out",
+        &cluster,
+        "--shards",
+        "3",
+        "--partition",
+        "debug",
+        "--time",
+        "00:10:00",
+        "--cpus-per-task",
+        "2",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v = json(&o);
-    assert_eq!((v["points"].as_u64(), v["shards"].as_u64()), (Some(24), Some(3)));
+    assert_eq!(
+        (v["points"].as_u64(), v["shards"].as_u64()),
+        (Some(24), Some(3))
+    );
     let array = std::fs::read_to_string(Path::new(&cluster).join("sweep.sbatch")).unwrap();
     let exe = std::fs::canonicalize(env!("CARGO_BIN_EXE_magsep")).unwrap();
     let sweep_abs = std::fs::canonicalize(&sweep).unwrap();
@@ -288,7 +330,15 @@ fn slurm_scripts_run_task_by_task_equal_the_local_sweep() {
     assert!(o.status.success(), "merge: {}", stderr(&o));
     assert_eq!(csv(&cluster), whole);
     // options that would break the script are refused
-    let o = magsep(&["sweep", "slurm", &sweep, "--out", &cluster, "--time", "1\n#SBATCH -x"]);
+    let o = magsep(&[
+        "sweep",
+        "slurm",
+        &sweep,
+        "--out",
+        &cluster,
+        "--time",
+        "1\n#SBATCH -x",
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--time"), "{}", stderr(&o));
 }
@@ -301,18 +351,45 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
             SWEEP.replace("values = [1e-2, 2e-2]", "values = [1e-2, -2.0]"),
             "brownian.duration",
         ),
-        (SWEEP.replace("path = \"brownian", "pth = \"brownian"), "axes[1]"),
-        (SWEEP.replace("num = 3", "num = 0"), "axes[0].logspace.num"),
-        (SWEEP.replace("start = 50e-9", "start = -1.0"), "axes[0].logspace.start"),
-        (SWEEP.replace("replicates = 4", "replicates = 0"), "replicates"),
-        (SWEEP.replace("scene = \"base.toml\"", "scene = \"none.toml\""), "scene"),
-        (format!("zip = [[\"radius\", \"brownian.duration\"]]\n{SWEEP}"), "zip[0][1]"),
-        (format!("zip = [[\"radius\", \"nope\"]]\n{SWEEP}"), "zip[0][1]"),
         (
-            SWEEP.replace("values = [1e-2, 2e-2]", "range = { start = 1, stop = 3, step = -1 }"),
+            SWEEP.replace("path = \"brownian", "pth = \"brownian"),
+            "axes[1]",
+        ),
+        (SWEEP.replace("num = 3", "num = 0"), "axes[0].logspace.num"),
+        (
+            SWEEP.replace("start = 50e-9", "start = -1.0"),
+            "axes[0].logspace.start",
+        ),
+        (
+            SWEEP.replace("replicates = 4", "replicates = 0"),
+            "replicates",
+        ),
+        (
+            SWEEP.replace("scene = \"base.toml\"", "scene = \"none.toml\""),
+            "scene",
+        ),
+        (
+            format!("zip = [[\"radius\", \"brownian.duration\"]]\n{SWEEP}"),
+            "zip[0][1]",
+        ),
+        (
+            format!("zip = [[\"radius\", \"nope\"]]\n{SWEEP}"),
+            "zip[0][1]",
+        ),
+        (
+            SWEEP.replace(
+                "values = [1e-2, 2e-2]",
+                "range = { start = 1, stop = 3, step = -1 }",
+            ),
             "axes[1].range.step",
         ),
-        (SWEEP.replace("path = \"brownian.duration\"", "path = \"particles[4].count\""), "particles[4]"),
+        (
+            SWEEP.replace(
+                "path = \"brownian.duration\"",
+                "path = \"particles[4].count\"",
+            ),
+            "particles[4]",
+        ),
     ];
     for (k, (text, key)) in cases.iter().enumerate() {
         let sweep = write_sweep(&dir, text);
@@ -321,7 +398,10 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
         assert_eq!(o.status.code(), Some(2), "case {k}: {}", stderr(&o));
         assert!(stderr(&o).contains(key), "case {k}: {}", stderr(&o));
         assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
-        assert!(!Path::new(&o_dir).join("points").exists(), "case {k} ran points");
+        assert!(
+            !Path::new(&o_dir).join("points").exists(),
+            "case {k} ran points"
+        );
     }
     // a point whose scene validates but fails to run is that point's error, not the sweep's
     let text = "scene = \"base.toml\"\ncollect = [\"steps\"]\n[[axes]]\n\
@@ -334,7 +414,10 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
     assert_eq!((v["ok"].as_u64(), v["failed"].as_u64()), (Some(1), Some(1)));
     let table = csv(&out(&dir, "failing"));
     let row = table.lines().nth(2).unwrap();
-    assert!(row.contains(",error,") && row.contains("start region"), "{row}");
+    assert!(
+        row.contains(",error,") && row.contains("start region"),
+        "{row}"
+    );
 }
 
 #[test]
@@ -362,7 +445,11 @@ linspace = { start = 1e-3, stop = 3e-3, num = 3 }
     let o = magsep(&["sweep", &sweep, "--out", &o_dir, "--quiet", "--jobs", "2"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let table = csv(&o_dir);
-    let rows: Vec<Vec<&str>> = table.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let rows: Vec<Vec<&str>> = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     assert_eq!(rows.len(), 6, "{table}");
     for r in &rows {
         // n particles for n ms (n steps): the zipped axes move together; replicate 0 and the

@@ -85,7 +85,11 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
         } else {
             (others.iter().zip(&key))
                 .map(|(&k, &v)| {
-                    format!("{}={}", sweep.axes[k].name, value_cell(&sweep.axes[k].values[v]))
+                    format!(
+                        "{}={}",
+                        sweep.axes[k].name,
+                        value_cell(&sweep.axes[k].values[v])
+                    )
                 })
                 .collect::<Vec<_>>()
                 .join(", ")

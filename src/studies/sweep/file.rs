@@ -174,7 +174,10 @@ fn space_values(s: &SpaceSpec, log: bool, at: &str, errors: &mut Vec<SceneError>
     for (key, v) in [("start", s.start), ("stop", s.stop)] {
         if !v.is_finite() || (log && v <= 0.0) {
             let rule = if log { "finite and > 0" } else { "finite" };
-            errors.push(err(format!("{at}.{key}"), format!("must be {rule}, got {v}")));
+            errors.push(err(
+                format!("{at}.{key}"),
+                format!("must be {rule}, got {v}"),
+            ));
         }
     }
     if s.num == 0 || s.num as usize > MAX_POINTS {
@@ -215,7 +218,10 @@ fn space_values(s: &SpaceSpec, log: bool, at: &str, errors: &mut Vec<SceneError>
 fn edit_value(v: &toml::Value) -> Option<Value> {
     let mut t = toml::Table::new();
     t.insert("v".into(), v.clone());
-    let doc = toml::to_string(&t).ok()?.parse::<toml_edit::DocumentMut>().ok()?;
+    let doc = toml::to_string(&t)
+        .ok()?
+        .parse::<toml_edit::DocumentMut>()
+        .ok()?;
     doc.get("v")?.as_value().cloned()
 }
 
@@ -310,8 +316,8 @@ impl Sweep {
     /// # Errors
     /// Every problem at its key path (`scene` when the base scene cannot be read).
     pub fn load(path: &Path) -> Result<Self, SceneErrors> {
-        let text = crate::input::read_scene_text(path)
-            .map_err(|e| SceneErrors(vec![err("(file)", e)]))?;
+        let text =
+            crate::input::read_scene_text(path).map_err(|e| SceneErrors(vec![err("(file)", e)]))?;
         let spec = parse_spec(&text)?;
         let dir = path.parent().unwrap_or(Path::new(""));
         let scene_path = dir.join(&spec.scene);

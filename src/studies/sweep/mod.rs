@@ -59,8 +59,7 @@ pub struct SweepRun {
 /// # Errors
 /// [`SweepError::Input`] naming the file.
 pub fn load(path: &Path) -> Result<Sweep, SweepError> {
-    Sweep::load(path)
-        .map_err(|e| SweepError::Input(format!("{} is invalid:\n{e}", path.display())))
+    Sweep::load(path).map_err(|e| SweepError::Input(format!("{} is invalid:\n{e}", path.display())))
 }
 
 /// Load the sweep and validate every point's scene (all of them, also when sharded, so a
@@ -262,7 +261,10 @@ pub fn write_slurm(
             "--shards and --cpus-per-task must be at least 1".into(),
         ));
     }
-    for (flag, v) in [("--partition", &options.partition), ("--time", &options.time)] {
+    for (flag, v) in [
+        ("--partition", &options.partition),
+        ("--time", &options.time),
+    ] {
         if let Some(v) = v {
             slurm::check_word(flag, v).map_err(SweepError::Input)?;
         }
@@ -270,8 +272,7 @@ pub fn write_slurm(
     let sweep = load_checked(sweep_path, registry)?;
     check_inputs(sweep_path, &sweep, out)?;
     let abs = |p: &Path| {
-        std::path::absolute(p)
-            .map_err(|e| SweepError::Runtime(format!("{}: {e}", p.display())))
+        std::path::absolute(p).map_err(|e| SweepError::Runtime(format!("{}: {e}", p.display())))
     };
     let (sweep_abs, out_abs) = (abs(sweep_path)?, abs(out)?);
     open_dir(&sweep, out).map_err(|(input, m)| {
@@ -284,7 +285,10 @@ pub fn write_slurm(
     std::fs::create_dir_all(out.join("slurm"))
         .map_err(|e| SweepError::Runtime(format!("{}: {e}", out.display())))?;
     let files = [
-        ("sweep.sbatch", slurm::array_script(exe, &sweep_abs, &out_abs, options)),
+        (
+            "sweep.sbatch",
+            slurm::array_script(exe, &sweep_abs, &out_abs, options),
+        ),
         ("merge.sbatch", slurm::merge_script(exe, &out_abs, options)),
         ("submit.sh", slurm::submit_script(&out_abs)),
     ];

@@ -242,8 +242,11 @@ impl Runner<'_> {
         }
         std::fs::create_dir_all(&tmp).map_err(io)?;
         let pretty = |v: &Value| serde_json::to_string_pretty(v).unwrap_or_default();
-        std::fs::write(tmp.join("point.json"), pretty(&point_json(self.sweep, &point)))
-            .map_err(io)?;
+        std::fs::write(
+            tmp.join("point.json"),
+            pretty(&point_json(self.sweep, &point)),
+        )
+        .map_err(io)?;
         let run = || -> (Option<Value>, Option<String>) {
             let base = base.clone();
             let scene = match point_scene(self.sweep, &base, &point, self.registry) {
@@ -261,10 +264,7 @@ impl Runner<'_> {
                     let failure = scene.pipeline.as_ref().and_then(|p| p.failure(&summary));
                     (Some(summary), failure)
                 }
-                Err(e) => (
-                    SimError::partial_summary(&e).cloned(),
-                    Some(e.to_string()),
-                ),
+                Err(e) => (SimError::partial_summary(&e).cloned(), Some(e.to_string())),
             }
         };
         let (summary, error) = catch_unwind(AssertUnwindSafe(run))
@@ -273,13 +273,11 @@ impl Runner<'_> {
             std::fs::write(tmp.join("summary.json"), pretty(s)).map_err(io)?;
         }
         if let Some(e) = &error {
-            std::fs::write(tmp.join("error.json"), pretty(&json!({ "error": e })))
-                .map_err(io)?;
+            std::fs::write(tmp.join("error.json"), pretty(&json!({ "error": e }))).map_err(io)?;
         }
         let dir = point_dir(self.out, index);
-        std::fs::rename(&tmp, &dir).map_err(|e| {
-            format!("cannot move {} to {}: {e}", tmp.display(), dir.display())
-        })?;
+        std::fs::rename(&tmp, &dir)
+            .map_err(|e| format!("cannot move {} to {}: {e}", tmp.display(), dir.display()))?;
         Ok(error.is_none())
     }
 

@@ -84,9 +84,7 @@ pub fn csv_text(sweep: &Sweep, rows: &[Row]) -> Result<String, String> {
     w.write_record(&header).map_err(|e| e.to_string())?;
     for r in rows {
         let mut cells = vec![r.index.to_string()];
-        cells.extend(
-            (sweep.axes.iter().zip(&r.values)).map(|(a, &v)| value_cell(&a.values[v])),
-        );
+        cells.extend((sweep.axes.iter().zip(&r.values)).map(|(a, &v)| value_cell(&a.values[v])));
         cells.push(r.replicate.to_string());
         cells.push(r.seed.map(|s| s.to_string()).unwrap_or_default());
         cells.extend(r.collected.iter().map(|v| json_cell(v.as_ref())));

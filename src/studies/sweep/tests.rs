@@ -8,8 +8,7 @@ use super::run::{parse_shard, shard_points};
 const SCENE: &str = "[simulation]\npipeline = \"packing\"\nseed = 7\n";
 
 fn sweep(text: &str) -> Sweep {
-    Sweep::from_texts(text, PathBuf::from("s.toml"), SCENE.into())
-        .unwrap_or_else(|e| panic!("{e}"))
+    Sweep::from_texts(text, PathBuf::from("s.toml"), SCENE.into()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn cells(s: &Sweep, axis: usize) -> Vec<String> {
@@ -29,7 +28,11 @@ fn generators_give_the_documented_values() {
     assert_eq!(cells(&s, 0), ["1", "4", "7"]);
     assert_eq!(s.axes[1].values.len(), 4);
     assert_eq!(cells(&s, 2), ["0.0", "0.25", "0.5", "0.75", "1.0"]);
-    let d: Vec<f64> = s.axes[3].values.iter().map(|v| v.as_float().unwrap()).collect();
+    let d: Vec<f64> = s.axes[3]
+        .values
+        .iter()
+        .map(|v| v.as_float().unwrap())
+        .collect();
     assert_eq!((d[0], d[3]), (1e-9, 1e-6));
     for (k, x) in d.iter().enumerate() {
         assert!((x.log10() - (-9.0 + k as f64)).abs() < 1e-12, "{x}");
@@ -49,14 +52,24 @@ fn points_cross_axes_first_slowest_with_replicates_innermost() {
     );
     assert_eq!(s.len(), 3 * 2 * 2);
     let p = s.point(0);
-    assert_eq!((p.values.clone(), p.replicate, p.seed), (vec![0, 0, 0], 0, Some(10)));
+    assert_eq!(
+        (p.values.clone(), p.replicate, p.seed),
+        (vec![0, 0, 0], 0, Some(10))
+    );
     let p = s.point(1);
-    assert_eq!((p.values.clone(), p.replicate, p.seed), (vec![0, 0, 0], 1, Some(11)));
+    assert_eq!(
+        (p.values.clone(), p.replicate, p.seed),
+        (vec![0, 0, 0], 1, Some(11))
+    );
     let p = s.point(3);
     assert_eq!((p.values.clone(), p.replicate), (vec![0, 1, 1], 1));
     let p = s.point(11);
     assert_eq!((p.values.clone(), p.replicate), (vec![2, 1, 1], 1));
-    let ovs: Vec<String> = s.overrides(&s.point(5)).iter().map(|o| o.to_string()).collect();
+    let ovs: Vec<String> = s
+        .overrides(&s.point(5))
+        .iter()
+        .map(|o| o.to_string())
+        .collect();
     assert_eq!(ovs, ["a=2", "b=10", "c=100", "simulation.seed=11"]);
 }
 
