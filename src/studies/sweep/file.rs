@@ -311,7 +311,7 @@ fn groups(spec: &SweepSpec, axes: &[Axis], errors: &mut Vec<SceneError>) -> Vec<
 
 impl Sweep {
     /// Read and validate the sweep file at `path` and its base scene (the file only; see
-    /// [`Sweep::check_points`] for the points' scenes).
+    /// [`super::run::check_points`] for the points' scenes).
     ///
     /// # Errors
     /// Every problem at its key path (`scene` when the base scene cannot be read).
