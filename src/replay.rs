@@ -268,7 +268,8 @@ pub fn resume(
 ) -> Result<Value, ReplayError> {
     let rec = read_recording(path)?;
     let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
-    let scene = parse_scene(&meta.scene_text, registry)?;
+    let mut scene = parse_scene(&meta.scene_text, registry)?;
+    scene.overrides = recorded_overrides(&meta);
     let frame = last_frame(&rec)?.clone();
     check_resume(&scene, &meta, &rec, &frame)?;
     let options = RunOptions {
@@ -289,4 +290,12 @@ pub fn resume(
         return Err(ReplayError::MissingPlugins(missing.join(", ")));
     }
     Ok(sim.run(on_step)?)
+}
+
+/// The overrides a recording's metadata lists (`extra["overrides"]`; empty when absent).
+pub fn recorded_overrides(meta: &RecordingMetadata) -> Vec<String> {
+    meta.extra
+        .get(crate::sim::OVERRIDES_KEY)
+        .and_then(|s| serde_json::from_str(s).ok())
+        .unwrap_or_default()
 }

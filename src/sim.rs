@@ -344,7 +344,7 @@ fn open_recording(
             .into_iter()
             .map(|(name, params)| PluginInfo { name, params })
             .collect(),
-        extra: Default::default(),
+        extra: overrides_metadata(&scene.overrides),
     };
     let mut writer = RecordingWriter::create(path, &meta)?;
     if !scene.record.as_ref().is_some_and(|r| r.flush_every_frame) {
@@ -389,6 +389,23 @@ fn open_recording(
     pipeline.prepare_recording(&mut app.world, &mut writer);
     Ok(writer)
 }
+
+/// The recording's `extra` metadata for the overrides applied to the scene: key `overrides`,
+/// a JSON list of `PATH=VALUE` strings (nothing when there are none).
+fn overrides_metadata(overrides: &[String]) -> std::collections::BTreeMap<String, String> {
+    let mut extra = std::collections::BTreeMap::new();
+    if !overrides.is_empty() {
+        extra.insert(
+            OVERRIDES_KEY.to_string(),
+            serde_json::to_string(overrides).unwrap_or_default(),
+        );
+    }
+    extra
+}
+
+/// The key of [`RecordingMetadata::extra`] that lists the overrides of the run (a JSON list of
+/// `PATH=VALUE` strings); the recorded scene text already has them applied.
+pub const OVERRIDES_KEY: &str = "overrides";
 
 /// Run `scene` to the end the pipeline's way (one simulation, or e.g. replicates), reporting
 /// to `progress`; returns the summary. A set [`RunOptions::stop`] ends the run early with the

@@ -133,7 +133,7 @@ pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliEr
             "complete": rec.truncated.is_none() && rec.damaged.is_none(),
             "interrupted": rec.interrupted,
             "memory_estimate_bytes": memory.as_ref().map(|m| m.bytes.round() as u64),
-            "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text})),
+            "metadata": meta.map(|m| json!({"seed": m.seed, "version": m.version, "pipeline": m.pipeline, "dt": m.dt, "schedule": m.schedule, "scene_text": m.scene_text, "overrides": crate::replay::recorded_overrides(m)})),
             "summary": rec.summary_json.as_deref().and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok()),
         });
         print(serde_json::to_string_pretty(&v).unwrap_or_default())?;
@@ -184,6 +184,10 @@ pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliEr
                 "scene text ({} lines)",
                 m.scene_text.lines().count()
             ));
+            let overrides = crate::replay::recorded_overrides(m);
+            if !overrides.is_empty() {
+                line(format!("overrides  {}", overrides.join(" ")));
+            }
             if let Some(e) = &memory {
                 line(format!(
                     "memory     about {} to run the scene ({})",

@@ -28,6 +28,7 @@ mod info;
 mod output;
 mod run;
 pub mod signals;
+mod sweep;
 
 /// A CLI failure with its exit code (2 bad input, 1 runtime failure, 130/143 interrupted). An
 /// empty message is not printed (a closed standard output ends the command quietly).
@@ -92,11 +93,18 @@ enum Command {
         /// Overwrite an existing --record file (never an input of the run).
         #[arg(long)]
         force: bool,
+        /// Override a scene value: PATH=VALUE, e.g. `brownian.duration=2.0` or
+        /// `particles[0].shape.radius=75e-9` (VALUE is TOML; repeatable; recorded).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<String>,
     },
     /// Validate a scene: exit 0 if valid, 2 with every error (and its key path) if not.
     Validate {
         /// Scene file (TOML).
         scene: PathBuf,
+        /// Override a scene value: PATH=VALUE (as for `run`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<String>,
         /// Memory budget [GiB] (as for `run`).
         #[arg(long, value_name = "GiB")]
         memory_budget: Option<f64>,
@@ -167,6 +175,9 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Parameter sweeps: `magsep sweep SWEEP.toml --out DIR [--jobs J] [--shard I/N]`,
+    /// `magsep sweep merge DIR`, `magsep sweep slurm SWEEP.toml --out DIR --shards N`.
+    Sweep(sweep::SweepCommand),
     /// Benchmarks (`magsep bench packing`, `magsep bench particle-fluid --json`).
     Bench {
         /// What to benchmark.
@@ -242,6 +253,7 @@ pub fn main_with(ext: Extensions) -> i32 {
             threads,
             memory_budget,
             force,
+            set,
         } => run::run(
             &ext,
             run::RunArgs {
@@ -252,12 +264,14 @@ pub fn main_with(ext: Extensions) -> i32 {
                 threads,
                 force,
                 memory_budget,
+                set,
             },
         ),
         Command::Validate {
             scene,
+            set,
             memory_budget,
-        } => run::validate(&ext, &scene, memory_budget),
+        } => run::validate(&ext, &scene, &set, memory_budget),
         Command::Field {
             scene,
             points,
@@ -299,6 +313,7 @@ pub fn main_with(ext: Extensions) -> i32 {
                 info::replay(&ext, &recording)
             }
         }
+        Command::Sweep(cmd) => sweep::sweep(&ext, cmd),
         Command::Bench { what, json, quick } => {
             crate::studies::bench::bench(what, json, quick).map_err(to_cli)
         }

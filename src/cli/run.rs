@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
+use crate::scene::overrides::{Override, apply_overrides};
 use crate::scene::{Progress, RunOptions, Scene, parse_scene};
 use crate::sim::{SimError, StopFlag, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -50,10 +51,44 @@ pub fn scene_inputs(path: &Path, text: &str) -> Vec<Input> {
     inputs
 }
 
-/// Parse the scene text `text` of the file `path`.
-pub fn parse(ext: &Extensions, path: &Path, text: &str) -> Result<Scene, CliError> {
-    parse_scene(text, &ext.registry)
-        .map_err(|e| CliError::input(format!("{} is invalid:\n{e}", path.display())))
+/// The text of the scene file `path` with the `--set` overrides `set` applied, and the
+/// overrides as recorded (`PATH=VALUE`); bad overrides are bad input at their key path.
+pub fn text_with_overrides(path: &Path, set: &[String]) -> Result<(String, Vec<String>), CliError> {
+    let text = scene_text(path)?;
+    let invalid = |e: crate::scene::SceneErrors| {
+        CliError::input(format!("{} with --set is invalid:\n{e}", path.display()))
+    };
+    let mut overrides = Vec::new();
+    let mut errors = Vec::new();
+    for arg in set {
+        match Override::parse(arg) {
+            Ok(o) => overrides.push(o),
+            Err(e) => errors.push(e),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(invalid(crate::scene::SceneErrors(errors)));
+    }
+    let text = apply_overrides(&text, &overrides).map_err(invalid)?;
+    Ok((text, overrides.iter().map(Override::to_string).collect()))
+}
+
+/// Parse the scene file `path` with the overrides `set` applied (see [`text_with_overrides`]).
+fn parse_with_overrides(
+    ext: &Extensions,
+    path: &Path,
+    text: &str,
+    overrides: Vec<String>,
+) -> Result<Scene, CliError> {
+    let what = if overrides.is_empty() {
+        ""
+    } else {
+        " with --set"
+    };
+    let mut scene = parse_scene(text, &ext.registry)
+        .map_err(|e| CliError::input(format!("{}{what} is invalid:\n{e}", path.display())))?;
+    scene.overrides = overrides;
+    Ok(scene)
 }
 
 /// The scene's memory estimate, checked against the budget (exit 2 when over).
@@ -68,8 +103,14 @@ fn memory(
     Ok((estimate, budget))
 }
 
-pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Result<(), CliError> {
-    let scene = parse(ext, path, &scene_text(path)?)?;
+pub fn validate(
+    ext: &Extensions,
+    path: &Path,
+    set: &[String],
+    budget_gib: Option<f64>,
+) -> Result<(), CliError> {
+    let (text, overrides) = text_with_overrides(path, set)?;
+    let scene = parse_with_overrides(ext, path, &text, overrides)?;
     let (estimate, budget) = memory(&scene, path, budget_gib)?;
     print(serde_json::json!({
         "valid": true,
@@ -80,6 +121,7 @@ pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Resul
         "memory_estimate_bytes": estimate.bytes.round() as u64,
         "memory_estimate": estimate.detail,
         "memory_budget_bytes": budget,
+        "overrides": scene.overrides,
     }))
 }
 
@@ -113,6 +155,8 @@ pub struct RunArgs {
     pub threads: Option<usize>,
     pub force: bool,
     pub memory_budget: Option<f64>,
+    /// `--set PATH=VALUE` overrides, in order.
+    pub set: Vec<String>,
 }
 
 /// `magsep run`: the output path is checked before anything runs (see `output`).
@@ -125,14 +169,15 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         threads,
         force,
         memory_budget,
+        set,
     } = args;
     let path = path.as_path();
-    let text = scene_text(path)?;
+    let (text, overrides) = text_with_overrides(path, &set)?;
     if let Some(out) = &record {
         check_file("--record", out, &scene_inputs(path, &text), force)?;
     }
     let single = set_threads(threads)?;
-    let scene = parse(ext, path, &text)?;
+    let scene = parse_with_overrides(ext, path, &text, overrides)?;
     memory(&scene, path, memory_budget)?;
     let stop = StopFlag::new();
     let signals = signals::install(&stop)

@@ -20,6 +20,7 @@ pub mod checks;
 mod fibre_packing;
 mod fibres;
 pub mod memory;
+pub mod overrides;
 pub mod pipeline;
 pub mod placement;
 mod sections;
@@ -63,8 +64,13 @@ pub trait SceneKind: Send + Sync {
 /// A parsed and validated scene.
 #[derive(Clone)]
 pub struct Scene {
-    /// The file's text, verbatim (recorded in the recording's metadata).
+    /// The file's text, verbatim, with any overrides applied (recorded in the recording's
+    /// metadata).
     pub text: String,
+    /// The overrides (`PATH=VALUE`, see [`overrides`]) already applied to [`Scene::text`],
+    /// recorded in the recording's metadata (`extra["overrides"]`, a JSON list); empty when the
+    /// file was run as it is.
+    pub overrides: Vec<String>,
     /// `[simulation]` (absent in a field-only scene).
     pub simulation: Option<SimulationSection>,
     /// The pipeline `[simulation]` names (absent in a field-only scene).

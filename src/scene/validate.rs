@@ -475,6 +475,7 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
         return Err(errors);
     }
     Ok(Scene {
+        overrides: Vec::new(),
         text: text.to_string(),
         simulation,
         pipeline,

@@ -13,3 +13,4 @@ pub mod fluid_charts;
 pub mod liquid;
 pub mod packing_charts;
 pub mod sq_study;
+pub mod sweep;

@@ -1,0 +1,177 @@
+//! `magsep sweep SWEEP.toml --out DIR`, `magsep sweep merge DIR`, `magsep sweep slurm
+//! SWEEP.toml --out DIR` (see `crate::studies::sweep`).
+
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::output::{check_dir, print};
+use super::{CliError, Extensions};
+use crate::studies::sweep::{self, SweepError, slurm::SlurmOptions};
+
+/// `magsep sweep`: run a sweep file, or `merge` / `slurm`.
+#[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct SweepCommand {
+    #[command(subcommand)]
+    command: Option<SweepSub>,
+    /// Sweep file (TOML).
+    #[arg(required = true)]
+    sweep: Option<PathBuf>,
+    /// Sweep directory (created; a restarted sweep skips its finished points).
+    #[arg(long, required = true)]
+    out: Option<PathBuf>,
+    /// Points run at once (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Write each point's recording (points/<index>/recording.mcap).
+    #[arg(long)]
+    record: bool,
+    /// Run only shard I of N (1-based): the points whose index % N == I - 1.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    /// Run failed points again (finished points are otherwise never redone).
+    #[arg(long)]
+    retry_failed: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum SweepSub {
+    /// Build results.csv and the charts from the points finished so far (partial results
+    /// allowed: missing points are counted and left empty).
+    Merge {
+        /// Sweep directory.
+        dir: PathBuf,
+    },
+    /// Write a Slurm job array (one task per shard) and a merge job into DIR.
+    Slurm {
+        /// Sweep file (TOML).
+        sweep: PathBuf,
+        /// Sweep directory (scripts, logs and results).
+        #[arg(long)]
+        out: PathBuf,
+        /// Number of shards = array tasks.
+        #[arg(long, default_value_t = 1)]
+        shards: usize,
+        /// Slurm partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// Time limit per task (Slurm format, e.g. 01:00:00).
+        #[arg(long)]
+        time: Option<String>,
+        /// CPUs per task (each task runs this many points at once).
+        #[arg(long, default_value_t = 1)]
+        cpus_per_task: usize,
+        /// Write each point's recording.
+        #[arg(long)]
+        record: bool,
+    },
+}
+
+fn to_cli(e: SweepError) -> CliError {
+    match e {
+        SweepError::Input(m) => CliError::input(m),
+        SweepError::Runtime(m) => CliError::runtime(m),
+    }
+}
+
+fn pretty(v: &serde_json::Value) -> String {
+    serde_json::to_string_pretty(v).unwrap_or_default()
+}
+
+/// Run `magsep sweep ...`.
+pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
+    match cmd.command {
+        Some(SweepSub::Merge { dir }) => {
+            let result = sweep::merge(&dir).map_err(to_cli)?;
+            print(pretty(&result))?;
+            let missing = result["missing"].as_u64().unwrap_or(0);
+            if missing > 0 {
+                super::output::eprint(format!(
+                    "note: {missing} of {} points are not finished (status `missing` in \
+                     results.csv)",
+                    result["points"]
+                ));
+            }
+            Ok(())
+        }
+        Some(SweepSub::Slurm {
+            sweep: path,
+            out,
+            shards,
+            partition,
+            time,
+            cpus_per_task,
+            record,
+        }) => {
+            check_dir("--out", &out)?;
+            let exe = std::env::current_exe()
+                .map_err(|e| CliError::runtime(format!("cannot find the magsep binary: {e}")))?;
+            let options = SlurmOptions {
+                shards,
+                partition,
+                time,
+                cpus_per_task,
+                record,
+            };
+            let result =
+                sweep::write_slurm(&path, &out, &exe, &options, &ext.registry).map_err(to_cli)?;
+            print(pretty(&result))
+        }
+        None => {
+            let (Some(path), Some(out)) = (cmd.sweep, cmd.out) else {
+                return Err(CliError::input(
+                    "magsep sweep needs SWEEP.toml and --out DIR",
+                ));
+            };
+            check_dir("--out", &out)?;
+            let shard = cmd
+                .shard
+                .as_deref()
+                .map(sweep::run::parse_shard)
+                .transpose()
+                .map_err(CliError::input)?;
+            let jobs = match cmd.jobs {
+                Some(0) => return Err(CliError::input("--jobs must be at least 1")),
+                Some(j) => j.min(super::run::MAX_THREADS),
+                None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            };
+            let bar = if cmd.quiet {
+                ProgressBar::hidden()
+            } else {
+                ProgressBar::new(0)
+            };
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "[{elapsed_precise}] {bar:40} {pos}/{len} points ({eta} left)",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            let args = sweep::SweepRun {
+                sweep: path,
+                out,
+                jobs,
+                record: cmd.record,
+                shard,
+                retry_failed: cmd.retry_failed,
+            };
+            let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), &bar)
+                .map_err(to_cli)?;
+            print(pretty(&result))?;
+            let failed = result["failed"]
+                .as_u64()
+                .unwrap_or(result["failed_now"].as_u64().unwrap_or(0));
+            if failed > 0 {
+                return Err(CliError::runtime(format!(
+                    "{failed} points failed: see the status and error columns of results.csv \
+                     (or points/<index>/error.json)"
+                )));
+            }
+            Ok(())
+        }
+    }
+}
