@@ -81,7 +81,7 @@ mem_mib="$(( mem_mib * 95 / 100 ))"
 new_conf="$(cat <<CONF
 $MARKER
 ClusterName=magsep
-SlurmctldHost=$NODE
+SlurmctldHost=$NODE(127.0.0.1)
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
