@@ -87,11 +87,7 @@ fn flow_shifts_the_mean_and_keeps_the_variance() {
         let dx: Vec<DVec3> = x0.iter().zip(&x1).map(|(a, b)| *b - *a).collect();
         let nf = dx.len() as f64;
         let mean = dx.iter().copied().sum::<DVec3>() / nf;
-        let var = dx
-            .iter()
-            .map(|v| (*v - mean) * (*v - mean))
-            .sum::<DVec3>()
-            / (nf - 1.0);
+        let var = dx.iter().map(|v| (*v - mean) * (*v - mean)).sum::<DVec3>() / (nf - 1.0);
         let se = (2.0 * d * t / nf).sqrt();
         eprintln!(
             "{control}: mean displacement {mean:?} vs u t {:?} (SE {se:.2e} m); variance / 2Dt {:?}",
@@ -106,7 +102,10 @@ fn flow_shifts_the_mean_and_keeps_the_variance() {
                 u[k] * t
             );
             let r = var[k] / (2.0 * d * t);
-            assert!((r - 1.0).abs() < 0.05, "{control}: axis {k}: var / 2Dt = {r}");
+            assert!(
+                (r - 1.0).abs() < 0.05,
+                "{control}: axis {k}: var / 2Dt = {r}"
+            );
         }
     }
 }
@@ -159,7 +158,8 @@ placement = {{ kind = "points", positions = [{big}] }}
             flow = flow_line(u)
         )
     };
-    let adaptive = r#"{ kind = "adaptive", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }"#;
+    let adaptive =
+        r#"{ kind = "adaptive", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }"#;
     let multirate =
         r#"{ kind = "multirate", tolerance = 1e-2, max_displacement = 0.5, max_depth = 24 }"#;
     let mut substeps = Vec::new();
@@ -256,7 +256,9 @@ fn capture_falls_with_the_flow_speed() {
     assert!(fractions[1] >= 0.95, "slow flow: {fractions:?}");
     for k in 1..speeds.len() - 1 {
         let (p, q) = (fractions[k], fractions[k + 1]);
-        let se = ((p * (1.0 - p) + q * (1.0 - q)) / 64.0).sqrt().max(1.0 / 64.0);
+        let se = ((p * (1.0 - p) + q * (1.0 - q)) / 64.0)
+            .sqrt()
+            .max(1.0 / 64.0);
         assert!(
             p - q > 2.0 * se,
             "capture must fall from {} to {} m/s: {fractions:?}",
@@ -287,10 +289,77 @@ fn capture_falls_with_the_flow_speed() {
     assert!(!captured.is_empty() && !free.is_empty(), "{rows:?}");
     for (p, _) in &captured {
         let d = fibre.distance(*p);
-        assert!(d <= 2.0 * 125e-9, "captured particle at {p:?}, {d:e} m off the fibre");
+        assert!(
+            d <= 2.0 * 125e-9,
+            "captured particle at {p:?}, {d:e} m off the fibre"
+        );
     }
     for (p, _) in &free {
         // 0.5 s at 16 mm/s: 8 mm downstream, far past the 0.3 mm face
         assert!(p.x > 5e-3, "free particle not carried away: {p:?}");
     }
+}
+
+/// `kind = "darcy"` advects as the uniform flow of its interstitial velocity
+/// `−k ∇P / (η (1 − φ))` (Kozeny-Carman k, the scene's viscosity): the same seed gives the
+/// same positions to rounding, and the summary states the velocity.
+#[test]
+fn darcy_flow_is_the_uniform_flow_of_its_velocity() {
+    use magsep::brownian::flow::kozeny_carman_permeability;
+    let (eta, phi, grad) = (2e-3, 0.3, 2e3);
+    let k = kozeny_carman_permeability(phi, 400e-6, Some(4e-3), 5.0);
+    let u = DVec3::new(0.0, 0.0, -k * grad / (eta * (1.0 - phi)));
+    let darcy = format!(
+        "viscosity = {eta:e}\n[brownian.flow]\nkind = \"darcy\"\npressure_gradient = [0.0, 0.0, {grad:e}]\npacking_fraction = {phi}\nfibre_diameter = 400e-6\nfibre_length = 4e-3"
+    );
+    let uniform = format!("viscosity = {eta:e}\n{}", flow_line(u));
+    let (x0, xd, _) = start_and_end(&free_scene(50, 100e-9, 1e-3, 10, &darcy));
+    let (_, xu, _) = start_and_end(&free_scene(50, 100e-9, 1e-3, 10, &uniform));
+    // equal to rounding (u is formed in another order here: a few ulps of the velocity)
+    let worst = xd
+        .iter()
+        .zip(&xu)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0f64, f64::max);
+    assert!(worst < 1e-17, "darcy and uniform differ by {worst:e} m");
+    // the flow is visible: 0.01 s at |u| moves every particle by much more than its spread
+    let mean_dz = x0.iter().zip(&xd).map(|(a, b)| b.z - a.z).sum::<f64>() / 50.0;
+    assert!(
+        (mean_dz / (u.z * 0.01) - 1.0).abs() < 0.1,
+        "{mean_dz} vs {}",
+        u.z * 0.01
+    );
+    let s = run_ensemble(
+        &scene(&free_scene(5, 100e-9, 1e-3, 2, &darcy)),
+        1,
+        &RunOptions::default(),
+        &|_| {},
+    )
+    .expect("run");
+    let v = s["flow_velocity_m_s"][2]
+        .as_f64()
+        .expect("flow in the summary");
+    assert!((v / u.z - 1.0).abs() < 1e-12, "{v} vs {}", u.z);
+}
+
+/// The Brownian criterion (thesis eq. 6.24: squared displacement below twice 6Dt) is about
+/// motion relative to the liquid: with a flow that carries every particle 10 µm (far beyond
+/// sqrt(12 D t) = 0.5 µm) the fraction of Brownian particles is the same as without flow
+/// (fixed steps: the same noise), about P(χ²₃ < 6) = 0.89.
+#[test]
+fn brownian_criterion_is_relative_to_the_liquid() {
+    let fraction = |extra: &str| {
+        let text = free_scene(400, 100e-9, 1e-3, 20, extra);
+        let s = run_ensemble(&scene(&text), 1, &RunOptions::default(), &|_| {}).expect("run");
+        s["brownian_fraction"]["mean"].as_f64().expect("fraction")
+    };
+    let fixed = "step_control = { kind = \"fixed\" }\nmobility = \"free_draining\"";
+    let still = fraction(fixed);
+    let carried = fraction(&format!(
+        "{fixed}\n{}",
+        flow_line(DVec3::new(5e-4, 0.0, 0.0))
+    ));
+    eprintln!("Brownian fraction: no flow {still}, with flow {carried}");
+    assert_eq!(still, carried);
+    assert!((still - 0.89).abs() < 0.06, "{still}");
 }

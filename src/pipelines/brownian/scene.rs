@@ -131,7 +131,9 @@ impl BrownianSection {
             captured_interact: self.captured_interact.unwrap_or(true),
             observe_every: self.observe_every.unwrap_or((steps / 200).max(1)),
             field_patch: self.field_patch,
-            flow: self.flow.map_or([0.0; 3], |f| f.velocity().to_array()),
+            flow: self.flow.map_or([0.0; 3], |f| {
+                f.velocity(self.viscosity.unwrap_or(1e-3)).to_array()
+            }),
         }
     }
 
@@ -194,7 +196,7 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
         ));
     }
     if let Some(flow) = &b.flow {
-        validate_flow(flow, errors);
+        validate_flow(flow, b.viscosity.unwrap_or(1e-3), errors);
     }
     if let Some(t) = b.krylov_tolerance
         && !(t.is_finite() && t > 0.0 && t <= 0.1)
