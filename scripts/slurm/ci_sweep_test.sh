@@ -67,7 +67,7 @@ run_job() { # label, sbatch args...
   fi
   if [ "$rc" != 0 ]; then
     echo "$states" | sed 's/^/  /' >&2
-    for f in "$work"/*/*.out "$work"/*.out; do
+    for f in "$work"/*.out "$work"/*/*.out "$work"/*/slurm/*.out; do
       [ -f "$f" ] && { echo "---- $f" >&2; tail -n 30 "$f" >&2; }
     done
     fail "$label: job $id had a failed array task"
