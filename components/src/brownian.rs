@@ -252,6 +252,11 @@ pub struct BrownianConfig {
     /// exact field at every evaluation.
     #[serde(default)]
     pub field_patch: Option<f64>,
+    /// Mean velocity u of the liquid \[m/s\] (interstitial: the pore velocity that carries a
+    /// particle), added to every free particle's drift, `dx = (u + μF) dt + noise`; captured
+    /// particles do not move. Default zero (quiescent liquid).
+    #[serde(default)]
+    pub flow: [f64; 3],
 }
 
 impl BrownianConfig {

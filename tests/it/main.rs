@@ -5,6 +5,7 @@ mod bad_recordings;
 mod bad_scenes;
 mod bench_brownian;
 mod brownian_capture;
+mod brownian_flow;
 mod brownian_hydro;
 mod brownian_pipeline;
 mod brownian_replay;

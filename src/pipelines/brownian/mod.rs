@@ -2,6 +2,7 @@
 //! fibres, with capture, replicates run in parallel, replay of the capture curves and resume.
 
 pub mod ensemble;
+pub mod flow;
 pub mod placement;
 pub mod replay;
 pub mod scene;

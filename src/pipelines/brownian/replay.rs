@@ -150,8 +150,8 @@ pub fn frame_result(
     let brownian = (0..frame.ids.len())
         .map(|i| {
             let x0 = DVec3::from_array(b.initial_positions[i]);
-            let d2 = (frame.positions[i] - x0).length_squared();
-            is_brownian(&config, frame.radii[i], d2, t, b.captured[i].is_some())
+            let dx = frame.positions[i] - x0;
+            is_brownian(&config, frame.radii[i], dx, t, b.captured[i].is_some())
         })
         .collect();
     Ok(RunResult {

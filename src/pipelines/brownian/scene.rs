@@ -18,6 +18,7 @@
 //! contact = { kind = "mie", epsilon_kt = 100.0, n = 30.0, m = 15.0 }   # or hard_core, none
 //! dipole_cutoff = 30.0      # in mean radii of the pair; 0 switches dipole forces off
 //! captured_interact = true  # captured particles keep exerting dipole/contact forces
+//! flow = { kind = "uniform", velocity = [0.0, 0.0, -1e-3] }  # mean liquid velocity [m/s]
 //!
 //! [[particles]]
 //! count = 100
@@ -40,6 +41,7 @@ use magsep_components::brownian::{
 };
 use serde::{Deserialize, Serialize};
 
+use super::flow::{BrownianFlow, validate_flow};
 use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, num, within};
 use crate::scene::{FibreSpec, PlacementSpec, SceneError};
 
@@ -98,6 +100,9 @@ pub struct BrownianSection {
     /// Relative field-patch size ε in [1e-6, 0.5]; default: the exact field everywhere.
     #[serde(default)]
     pub field_patch: Option<f64>,
+    /// Mean flow of the liquid (`[brownian.flow]`, see [`super::flow`]). Default: none.
+    #[serde(default)]
+    pub flow: Option<BrownianFlow>,
 }
 
 impl BrownianSection {
@@ -126,6 +131,9 @@ impl BrownianSection {
             captured_interact: self.captured_interact.unwrap_or(true),
             observe_every: self.observe_every.unwrap_or((steps / 200).max(1)),
             field_patch: self.field_patch,
+            flow: self.flow.map_or([0.0; 3], |f| {
+                f.velocity(self.viscosity.unwrap_or(1e-3)).to_array()
+            }),
         }
     }
 
@@ -186,6 +194,9 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
             "brownian.field_patch",
             format!("must be in [1e-6, 0.5], got {e}"),
         ));
+    }
+    if let Some(flow) = &b.flow {
+        validate_flow(flow, b.viscosity.unwrap_or(1e-3), errors);
     }
     if let Some(t) = b.krylov_tolerance
         && !(t.is_finite() && t > 0.0 && t <= 0.1)

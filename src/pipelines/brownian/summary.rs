@@ -1,6 +1,7 @@
 //! Results of brownian runs and their JSON summary (one run or an ensemble).
 
 use bevy_ecs::prelude::*;
+use glam::DVec3;
 use magsep_components::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -33,10 +34,13 @@ pub struct RunResult {
 }
 
 /// The Brownian criterion of thesis eq. 6.24, per particle: free, and its squared displacement
-/// `d2` \[m²\] from the start after time `t` \[s\] below twice the free-diffusion value 2·6Dt,
-/// `D = k_B T / (6 π η a)` for radius `a` \[m\].
-pub fn is_brownian(config: &BrownianConfig, a: f64, d2: f64, t: f64, captured: bool) -> bool {
+/// from the start after time `t` \[s\] below twice the free-diffusion value 2·6Dt,
+/// `D = k_B T / (6 π η a)` for radius `a` \[m\]. `dx` \[m\] is the displacement; the mean
+/// flow's advection `u t` is taken out of it (the criterion is about motion relative to the
+/// liquid).
+pub fn is_brownian(config: &BrownianConfig, a: f64, dx: DVec3, t: f64, captured: bool) -> bool {
     let d = config.kt() / (6.0 * std::f64::consts::PI * config.viscosity * a);
+    let d2 = (dx - DVec3::from_array(config.flow) * t).length_squared();
     !captured && d2 < 2.0 * 6.0 * d * t
 }
 
@@ -61,7 +65,7 @@ pub fn run_result(world: &World, seed: u64) -> RunResult {
     rows.sort_by_key(|r| r.0);
     let brownian = rows
         .iter()
-        .map(|r| is_brownian(config, r.5, (r.3 - r.4).length_squared(), t, r.2.is_some()))
+        .map(|r| is_brownian(config, r.5, r.3 - r.4, t, r.2.is_some()))
         .collect();
     RunResult {
         seed,
@@ -219,7 +223,7 @@ pub fn summary_of(
         ));
     }
     let total_steps = (steps * results.len() as u64).max(1);
-    json!({
+    let mut summary = json!({
         "pipeline": "brownian",
         "seed": first.seed,
         "runs": results.len(),
@@ -251,7 +255,12 @@ pub fn summary_of(
         "groups": groups,
         "warnings": warnings,
         "wall_time_s": wall_time_s,
-    })
+    });
+    // the mean flow's velocity [m/s], only where there is one (older summaries stay as they were)
+    if config.flow != [0.0; 3] {
+        summary["flow_velocity_m_s"] = json!(config.flow);
+    }
+    summary
 }
 
 /// Summary of the run in `world`.

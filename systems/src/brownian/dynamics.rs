@@ -56,6 +56,10 @@ pub struct PipelineDynamics<'a> {
     pub viscosity: f64,
     /// Thermal energy \[J\].
     pub kt: f64,
+    /// Mean velocity of the liquid u \[m/s\]: it advects every free particle (added to the
+    /// drift after the mobility, so with hydrodynamic interactions too each particle moves
+    /// with u on top of `μ F`).
+    pub flow: DVec3,
     /// Hydrodynamic interactions (None: free draining).
     pub hydro: Option<&'a HydroState>,
     /// Neighbour lists of the pair forces (cached across evaluations).
@@ -111,13 +115,15 @@ impl PipelineDynamics<'_> {
             .collect()
     }
 
-    /// Velocities from forces `f` (masked to the free particles).
+    /// Velocities from forces `f` (masked to the free particles), plus the liquid's mean
+    /// velocity [`PipelineDynamics::flow`] for the free particles.
     pub fn velocities(&self, f: &[DVec3], v: &mut [DVec3]) {
         match self.hydro {
             None => {
                 for i in 0..f.len() {
                     v[i] = if self.mobile[i] {
                         f[i] / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
+                            + self.flow
                     } else {
                         DVec3::ZERO
                     };
@@ -130,7 +136,7 @@ impl PipelineDynamics<'_> {
                 v.fill(DVec3::ZERO);
                 for (k, &i) in h.rows.iter().enumerate() {
                     if self.mobile[i] {
-                        v[i] = vs[k];
+                        v[i] = vs[k] + self.flow;
                     }
                 }
             }
@@ -262,7 +268,7 @@ impl PipelineDynamics<'_> {
 impl LocalDynamics for PipelineDynamics<'_> {
     /// The forces on the `active` particles only, with the moments of the others held at their
     /// step-start values; free-draining mobility (the multirate stepper is not used with
-    /// hydrodynamic interactions).
+    /// hydrodynamic interactions), plus the liquid's mean velocity.
     fn drift_of(&mut self, x: &[DVec3], active: &[usize], v: &mut [DVec3]) {
         let exerts = self.exerts();
         let view = ParticleView {
@@ -306,7 +312,7 @@ impl LocalDynamics for PipelineDynamics<'_> {
         }
         for (fi, &i) in f.iter().zip(active) {
             v[i] = if self.mobile[i] {
-                *fi / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
+                *fi / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]) + self.flow
             } else {
                 DVec3::ZERO
             };

@@ -417,6 +417,7 @@ pub fn integrate_brownian(
         kernel_out: Vec::new(),
         viscosity: config.viscosity,
         kt: config.kt(),
+        flow: DVec3::from_array(config.flow),
         hydro: ws.hydro.as_ref(),
         lists: &mut ws.lists,
         start_moments: &ws.moments,

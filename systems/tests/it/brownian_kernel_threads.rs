@@ -69,6 +69,7 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
                 kernel_out: Vec::new(),
                 viscosity: 1e-3,
                 kt,
+                flow: DVec3::ZERO,
                 hydro: None,
                 lists: &mut lists,
                 start_moments: &[],
