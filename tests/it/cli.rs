@@ -1,22 +1,14 @@
 //! The `magsep` binary: exit codes, validation messages with key paths, record / info /
 //! replay, truncated and corrupt recordings, determinism across thread counts.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::magsep;
+use std::path::PathBuf;
+use std::process::Output;
 
 use magsep::plugins::record::read_recording;
 
-fn magsep(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_magsep"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    crate::common::tmp_path("cli", name)
 }
 
 const GOOD: &str = r#"

@@ -2,22 +2,14 @@
 //! with key paths like the file itself, equal to editing the file by hand, recorded in the
 //! recording's metadata (and `magsep replay` of it works).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::magsep;
+use std::path::PathBuf;
+use std::process::Output;
 
 use serde_json::Value;
 
-fn magsep(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_magsep"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("overrides");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    crate::common::tmp_path("overrides", name)
 }
 
 /// One free Brownian particle, 10 steps of 1 ms (SI units).

@@ -2,6 +2,7 @@
 //! byte, partial merges, up-front validation of every point, the Slurm scripts (run here
 //! task by task with `bash`, as Slurm would), and a failing point recorded, not fatal.
 
+use crate::common::magsep;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -9,13 +10,6 @@ use std::time::{Duration, Instant};
 use serde_json::Value;
 
 use super::overrides::TRIVIAL;
-
-fn magsep(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_magsep"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()

@@ -15,3 +15,18 @@ pub fn sorted_positions(sim: &mut Simulation) -> Vec<DVec3> {
     rows.sort_by_key(|r| r.0);
     rows.into_iter().map(|r| r.1).collect()
 }
+
+/// Run the `magsep` binary with `args` (in the test's working directory).
+pub fn magsep(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_magsep"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+/// The path `name` in the directory `group` of the tests' temporary directory (created).
+pub fn tmp_path(group: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(group);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
