@@ -1,7 +1,7 @@
 //! The `magsep` binary: exit codes, validation messages with key paths, record / info /
 //! replay, truncated and corrupt recordings, determinism across thread counts.
 
-use crate::common::magsep;
+use crate::common::{magsep, stderr};
 use std::path::PathBuf;
 use std::process::Output;
 
@@ -31,10 +31,6 @@ fn write(name: &str, text: &str) -> PathBuf {
     let p = tmp(name);
     std::fs::write(&p, text).unwrap();
     p
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 #[test]

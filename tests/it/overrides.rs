@@ -2,7 +2,7 @@
 //! with key paths like the file itself, equal to editing the file by hand, recorded in the
 //! recording's metadata (and `magsep replay` of it works).
 
-use crate::common::magsep;
+use crate::common::{magsep, stderr};
 use std::path::PathBuf;
 use std::process::Output;
 
@@ -35,10 +35,6 @@ fn write(name: &str, text: &str) -> PathBuf {
     let p = tmp(name);
     std::fs::write(&p, text).unwrap();
     p
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// The summary printed by a run, without its wall-clock times.

@@ -2,7 +2,7 @@
 //! byte, partial merges, up-front validation of every point, the Slurm scripts (run here
 //! task by task with `bash`, as Slurm would), and a failing point recorded, not fatal.
 
-use crate::common::magsep;
+use crate::common::{magsep, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -10,10 +10,6 @@ use std::time::{Duration, Instant};
 use serde_json::Value;
 
 use super::overrides::TRIVIAL;
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
-}
 
 fn json(o: &Output) -> Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", stderr(o)))
