@@ -198,7 +198,7 @@ def run(
     """
     if isinstance(scene, Mapping):
         scene = dict(scene)
-    elif not isinstance(scene, str):
+    elif isinstance(scene, os.PathLike):
         scene = os.fspath(scene)
     if progress is True:
         callback = _print_progress
@@ -214,7 +214,7 @@ def validate(scene: SceneLike, overrides: Overrides = None, memory_budget: Optio
     """Validate a scene (as ``magsep validate``): a dict with ``valid``, ``pipeline``,
     ``particles``, ``fibres`` and ``overrides``, or :class:`SceneError` listing every
     problem with its key path (``.errors``)."""
-    if not isinstance(scene, (str, Mapping)):
+    if isinstance(scene, os.PathLike):
         scene = os.fspath(scene)
     return _magsep.validate(scene, overrides, memory_budget)
 

@@ -90,5 +90,6 @@ fn _magsep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::validate, m)?)?;
     m.add_class::<recording::Recording>()?;
     m.add_function(wrap_pyfunction!(recording::open_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(recording::read_recording_frames, m)?)?;
     Ok(())
 }

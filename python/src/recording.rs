@@ -223,6 +223,24 @@ impl Recording {
     }
 }
 
+/// Every frame of the recording at `path` read by the library's whole-file reader
+/// ([`magsep_record::read_recording`], a linear scan checking every CRC), and its truncation
+/// message: the reference the streaming [`Recording`] is tested against.
+#[pyfunction]
+pub fn read_recording_frames<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyList>, Option<String>)> {
+    let rec = py
+        .detach(|| magsep_record::read_recording(&path))
+        .map_err(record_error)?;
+    let list = PyList::empty(py);
+    for f in rec.frames {
+        list.append(frame_dict(py, f)?)?;
+    }
+    Ok((list, rec.truncated))
+}
+
 /// Open the recording at `path` (streamed; nothing but its summary or a scan is read now).
 #[pyfunction]
 pub fn open_recording(py: Python<'_>, path: PathBuf) -> PyResult<Recording> {
