@@ -36,6 +36,7 @@ __all__ = [
     "run",
     "validate",
     "open_recording",
+    "contact_numbers",
     "Recording",
     "Frame",
     "Message",
@@ -416,6 +417,22 @@ class Recording:
     def __repr__(self) -> str:
         state = " (truncated)" if self.truncated else ""
         return f"<magsep.Recording {self.path!r}: {len(self)} frames{state}>"
+
+
+def contact_numbers(frame: Frame) -> Dict[str, Any]:
+    """Contact numbers of a recorded packing frame (spheres and spherocylinders in a periodic
+    box), by the packing pipeline's own analysis: ``mean`` (<C> extrapolated to zero gap, as
+    the summary's ``mean_contact_number``), ``mean_at_1e-4`` (gap below 1e-4 D),
+    ``histogram`` (``histogram[k]``: particles touching k others, gap below 1e-8 D),
+    ``samples`` ((gap / D, <C>) pairs of the fit), ``max_overlap`` (/ D) and
+    ``reference_diameter`` D [m] (the smallest particle diameter)."""
+    return _magsep.contact_numbers(
+        np.ascontiguousarray(frame.positions, dtype=np.float64),
+        np.ascontiguousarray(frame.orientations, dtype=np.float64),
+        np.ascontiguousarray(frame.radii, dtype=np.float64),
+        np.ascontiguousarray(frame.half_lengths, dtype=np.float64),
+        np.ascontiguousarray(frame.box_edges, dtype=np.float64),
+    )
 
 
 def open_recording(path: PathLike) -> Recording:

@@ -79,3 +79,10 @@ class Recording:
 
 def open_recording(path: str) -> Recording: ...
 def read_recording_frames(path: str) -> Tuple[List[Dict[str, Any]], Optional[str]]: ...
+def contact_numbers(
+    positions: np.ndarray,
+    orientations: np.ndarray,
+    radii: np.ndarray,
+    half_lengths: np.ndarray,
+    box_edges: np.ndarray,
+) -> Dict[str, Any]: ...

@@ -30,7 +30,8 @@ pub fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
 
 fn to_toml_at(obj: &Bound<'_, PyAny>, path: &str, depth: usize) -> PyResult<Value> {
     let py = obj.py();
-    let bad = |what: String| crate::key_error(py, if path.is_empty() { "(scene)" } else { path }, what);
+    let bad =
+        |what: String| crate::key_error(py, if path.is_empty() { "(scene)" } else { path }, what);
     if depth > MAX_DEPTH {
         return Err(bad(format!("nested more than {MAX_DEPTH} levels deep")));
     }
@@ -38,10 +39,12 @@ fn to_toml_at(obj: &Bound<'_, PyAny>, path: &str, depth: usize) -> PyResult<Valu
         return Ok(Value::Boolean(obj.extract()?));
     }
     if obj.is_instance_of::<PyInt>() {
-        return obj
-            .extract::<i64>()
-            .map(Value::Integer)
-            .map_err(|_| bad(format!("integer {} does not fit in 64 bits", obj.str().map(|s| s.to_string()).unwrap_or_default())));
+        return obj.extract::<i64>().map(Value::Integer).map_err(|_| {
+            bad(format!(
+                "integer {} does not fit in 64 bits",
+                obj.str().map(|s| s.to_string()).unwrap_or_default()
+            ))
+        });
     }
     if obj.is_instance_of::<PyFloat>() {
         return Ok(Value::Float(obj.extract()?));
@@ -53,10 +56,7 @@ fn to_toml_at(obj: &Bound<'_, PyAny>, path: &str, depth: usize) -> PyResult<Valu
         let mut table = toml::Table::new();
         for (k, v) in d.iter() {
             let Ok(key) = k.cast::<PyString>() else {
-                return Err(bad(format!(
-                    "keys must be strings, got {}",
-                    type_name(&k)
-                )));
+                return Err(bad(format!("keys must be strings, got {}", type_name(&k))));
             };
             let key = key.to_str()?.to_string();
             let value = to_toml_at(&v, &child(path, &key), depth + 1)?;
@@ -118,7 +118,8 @@ fn numpy_scalar(obj: &Bound<'_, PyAny>) -> PyResult<Option<Value>> {
 /// TOML text of a table (what the scene parser reads; floats are written so that they read
 /// back bit for bit).
 pub fn table_text(py: Python<'_>, table: &toml::Table) -> PyResult<String> {
-    toml::to_string(table).map_err(|e| crate::key_error(py, "(scene)", format!("cannot be written as TOML: {e}")))
+    toml::to_string(table)
+        .map_err(|e| crate::key_error(py, "(scene)", format!("cannot be written as TOML: {e}")))
 }
 
 /// A Python value from JSON text (through the `json` module: dicts, lists, floats, ints).

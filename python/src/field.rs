@@ -40,7 +40,10 @@ fn scene_table(
         return Err(crate::key_error(
             py,
             "fibres",
-            format!("expected a list of fibres (dicts of the scene's [[fibres]] keys), got {}", fibres.type_str()),
+            format!(
+                "expected a list of fibres (dicts of the scene's [[fibres]] keys), got {}",
+                fibres.type_str()
+            ),
         ));
     }
     table.insert("fibres".into(), fibres);
@@ -109,7 +112,13 @@ pub fn field<'py>(
     let array = py
         .import("numpy")?
         .call_method1("ascontiguousarray", (points, "float64"))
-        .map_err(|e| crate::key_error(py, "points", format!("expected an (N, 3) array of float64 [m]: {e}")))?;
+        .map_err(|e| {
+            crate::key_error(
+                py,
+                "points",
+                format!("expected an (N, 3) array of float64 [m]: {e}"),
+            )
+        })?;
     let shape: Vec<usize> = array.getattr("shape")?.extract()?;
     if shape.len() != 2 || shape[1] != 3 {
         return Err(crate::key_error(
@@ -122,7 +131,10 @@ pub fn field<'py>(
     let xyz = array
         .as_slice()
         .map_err(|e| crate::key_error(py, "points", format!("not contiguous: {e}")))?;
-    if let Some(k) = xyz.chunks_exact(3).position(|p| !p.iter().all(|c| c.is_finite())) {
+    if let Some(k) = xyz
+        .chunks_exact(3)
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
         return Err(crate::key_error(
             py,
             &format!("points[{k}]"),
@@ -132,12 +144,14 @@ pub fn field<'py>(
     let n = array.shape()[0];
     let b = PyArray2::<f64>::zeros(py, [n, 3], false);
     // SAFETY: `b` was just created here and is not shared with anyone.
-    let b_out = unsafe { b.as_slice_mut() }.map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let b_out = unsafe { b.as_slice_mut() }
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
     let pts = as_points(xyz);
     if gradient {
         let g = PyArray3::<f64>::zeros(py, [n, 3, 3], false);
         // SAFETY: as for `b`.
-        let g_out = unsafe { g.as_slice_mut() }.map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+        let g_out = unsafe { g.as_slice_mut() }
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
         let (rows, _) = g_out.as_chunks_mut::<9>();
         py.detach(|| gradient_values(&scene, pts, as_points_mut(b_out), rows));
         Ok(PyTuple::new(py, [b.into_any(), g.into_any()])?.into_any())

@@ -11,6 +11,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
+mod contacts;
 mod convert;
 mod field;
 mod recording;
@@ -88,6 +89,7 @@ fn _magsep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(field::field_scene_text, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(run::validate, m)?)?;
+    m.add_function(wrap_pyfunction!(contacts::contact_numbers, m)?)?;
     m.add_class::<recording::Recording>()?;
     m.add_function(wrap_pyfunction!(recording::open_recording, m)?)?;
     m.add_function(wrap_pyfunction!(recording::read_recording_frames, m)?)?;

@@ -37,7 +37,10 @@ impl Recording {
 }
 
 /// An (n, k) float64 array of `rows`.
-fn matrix<'py, const K: usize>(py: Python<'py>, rows: Vec<[f64; K]>) -> PyResult<Bound<'py, PyAny>> {
+fn matrix<'py, const K: usize>(
+    py: Python<'py>,
+    rows: Vec<[f64; K]>,
+) -> PyResult<Bound<'py, PyAny>> {
     let n = rows.len();
     let flat: Vec<f64> = rows.into_iter().flatten().collect();
     Ok(PyArray1::from_vec(py, flat).reshape([n, K])?.into_any())
@@ -48,7 +51,10 @@ fn frame_dict<'py>(py: Python<'py>, f: ParticleFrame) -> PyResult<Bound<'py, PyD
     let d = PyDict::new(py);
     d.set_item("step", f.step)?;
     d.set_item("time", f.time)?;
-    d.set_item("box_edges", PyArray1::from_vec(py, f.box_edges.to_array().to_vec()))?;
+    d.set_item(
+        "box_edges",
+        PyArray1::from_vec(py, f.box_edges.to_array().to_vec()),
+    )?;
     d.set_item("ids", PyArray1::from_vec(py, f.ids))?;
     d.set_item(
         "positions",
@@ -125,8 +131,7 @@ impl Recording {
     fn metadata<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         let meta = self.with_reader(|r| r.metadata().cloned())?;
         meta.map(|m| {
-            let v = serde_json::to_value(&m)
-                .map_err(|e| RecordingError::new_err(e.to_string()))?;
+            let v = serde_json::to_value(&m).map_err(|e| RecordingError::new_err(e.to_string()))?;
             json_value(py, &v)
         })
         .transpose()

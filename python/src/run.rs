@@ -52,25 +52,24 @@ fn source(scene: &Bound<'_, PyAny>) -> PyResult<Source> {
             name: "the scene dict".into(),
         });
     }
-    let path: Option<PathBuf> = if let Ok(s) = scene.cast::<PyString>() {
-        let s = s.to_str()?;
-        let looks_like_path =
-            !s.contains('\n') && (s.trim_end().ends_with(".toml") || Path::new(s).is_file());
-        if !looks_like_path {
-            return Ok(Source {
-                text: s.to_string(),
-                path: None,
-                name: "the scene text".into(),
-            });
-        }
-        Some(PathBuf::from(s))
-    } else {
-        Some(
-            scene
-                .extract::<PathBuf>()
-                .map_err(|_| crate::key_error(py, "(scene)", "expected a path, TOML text or a dict"))?,
-        )
-    };
+    let path: Option<PathBuf> =
+        if let Ok(s) = scene.cast::<PyString>() {
+            let s = s.to_str()?;
+            let looks_like_path =
+                !s.contains('\n') && (s.trim_end().ends_with(".toml") || Path::new(s).is_file());
+            if !looks_like_path {
+                return Ok(Source {
+                    text: s.to_string(),
+                    path: None,
+                    name: "the scene text".into(),
+                });
+            }
+            Some(PathBuf::from(s))
+        } else {
+            Some(scene.extract::<PathBuf>().map_err(|_| {
+                crate::key_error(py, "(scene)", "expected a path, TOML text or a dict")
+            })?)
+        };
     let path = path.unwrap_or_default();
     let text = read_scene_text(&path).map_err(|e| {
         crate::scene_error(
@@ -140,17 +139,24 @@ fn load(py: Python<'_>, src: &Source, set: &[String]) -> PyResult<Scene> {
     }
     let text =
         apply_overrides(&src.text, &parsed).map_err(|e| crate::scene_errors(py, &what, &e))?;
-    let mut scene = parse_scene(&text, &Default::default())
-        .map_err(|e| crate::scene_errors(py, &what, &e))?;
+    let mut scene =
+        parse_scene(&text, &Default::default()).map_err(|e| crate::scene_errors(py, &what, &e))?;
     scene.overrides = parsed.iter().map(Override::to_string).collect();
     Ok(scene)
 }
 
 /// The scene's memory estimate against the budget \[GiB\] (bad input when over).
-fn check_memory(py: Python<'_>, scene: &Scene, name: &str, budget_gib: Option<f64>) -> PyResult<()> {
-    let budget = memory::budget(budget_gib).map_err(|e| crate::key_error(py, "memory_budget", e))?;
-    memory::check(scene, budget)
-        .map_err(|e| crate::scene_error(py, &format!("{name} is invalid"), vec![(e.path, e.message)]))?;
+fn check_memory(
+    py: Python<'_>,
+    scene: &Scene,
+    name: &str,
+    budget_gib: Option<f64>,
+) -> PyResult<()> {
+    let budget =
+        memory::budget(budget_gib).map_err(|e| crate::key_error(py, "memory_budget", e))?;
+    memory::check(scene, budget).map_err(|e| {
+        crate::scene_error(py, &format!("{name} is invalid"), vec![(e.path, e.message)])
+    })?;
     Ok(())
 }
 
@@ -212,7 +218,10 @@ fn pool(py: Python<'_>, threads: Option<usize>) -> PyResult<Option<rayon::Thread
             format!("must be in 1..={MAX_THREADS}, got {n}"),
         ));
     }
-    if rayon::ThreadPoolBuilder::new().num_threads(n).build_global().is_ok()
+    if rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .is_ok()
         || rayon::current_num_threads() == n
     {
         return Ok(None);
@@ -256,7 +265,8 @@ impl Watch {
                     t => Some(t),
                 };
                 let message = shared.message.lock().ok().and_then(|m| m.clone());
-                if let Err(e) = cb.call1(py, (shared.done.load(Ordering::Relaxed), total, message)) {
+                if let Err(e) = cb.call1(py, (shared.done.load(Ordering::Relaxed), total, message))
+                {
                     stop.request_stop("progress callback raised");
                     self.error = Some(e);
                 }
@@ -295,14 +305,20 @@ fn run_watched(
             .spawn_scoped(s, work)
         {
             Ok(h) => h,
-            Err(e) => return Err(SimError::Schedule(format!("cannot start the run's thread: {e}"))),
+            Err(e) => {
+                return Err(SimError::Schedule(format!(
+                    "cannot start the run's thread: {e}"
+                )));
+            }
         };
         while let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(POLL) {
             watch.poll(stop, progress, shared);
         }
-        handle
-            .join()
-            .unwrap_or_else(|_| Err(SimError::Schedule("internal error: the run panicked".into())))
+        handle.join().unwrap_or_else(|_| {
+            Err(SimError::Schedule(
+                "internal error: the run panicked".into(),
+            ))
+        })
     });
     (result, watch.error)
 }
@@ -310,7 +326,9 @@ fn run_watched(
 /// A Python exception carrying `summary` as its `summary` attribute.
 fn with_summary(py: Python<'_>, err: PyErr, summary: Option<&Value>) -> PyErr {
     let value = match summary {
-        Some(s) => json_value(py, s).map(Bound::unbind).unwrap_or_else(|_| py.None()),
+        Some(s) => json_value(py, s)
+            .map(Bound::unbind)
+            .unwrap_or_else(|_| py.None()),
         None => py.None(),
     };
     let _ = err.value(py).setattr("summary", value);
@@ -343,7 +361,11 @@ pub fn run<'py>(
             inputs.push(Input::new("scene", p));
         }
         check_file("record", out, &inputs, force).map_err(|e| {
-            let message = e.message.strip_prefix("record ").unwrap_or(&e.message).to_string();
+            let message = e
+                .message
+                .strip_prefix("record ")
+                .unwrap_or(&e.message)
+                .to_string();
             crate::key_error(py, "record", message)
         })?;
     }

@@ -131,3 +131,17 @@ def test_to_pandas_has_one_row_per_particle_and_frame(packing):
     assert np.array_equal(t.x.to_numpy(), last.positions[:, 0])
     assert np.array_equal(t.qw.to_numpy(), last.orientations[:, 3])
     assert list(rec.to_pandas(frames=[0]).step.unique()) == [rec[0].step]
+
+
+def test_contact_numbers_of_the_final_frame_are_the_summary_s(packing):
+    path, summary = packing
+    rec = magsep.open_recording(path)
+    cn = magsep.contact_numbers(rec[-1])
+    assert cn["mean"] == summary["mean_contact_number"]
+    assert cn["mean_at_1e-4"] == summary["mean_contact_number_at_1e-4"]
+    assert sum(cn["histogram"]) == 80
+    bad = rec[-1]
+    bad.radii = bad.radii.copy()
+    bad.radii[3] = -1.0
+    with pytest.raises(ValueError, match=r"radii\[3\]"):
+        magsep.contact_numbers(bad)
