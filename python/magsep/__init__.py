@@ -120,6 +120,7 @@ def field(
     points: Any,
     external: Union[None, Sequence[float], Mapping[str, Any]] = None,
     gradient: bool = False,
+    out: Optional[np.ndarray] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """The magnetic flux density B [T] of ``fibres`` and ``external`` at ``points`` [m].
 
@@ -128,7 +129,8 @@ def field(
     ``saturation_magnetisation``), or one of them. ``points``: an (N, 3) float64 array (used
     without copying when C-contiguous) or one point of shape (3,). ``external``: B_ext [T]
     as three numbers, or a dict of the ``[external_field]`` keys (``flux_density``,
-    ``field_tolerance``).
+    ``field_tolerance``). ``out``: a C-contiguous float64 (N, 3) array to write B into (reused
+    between calls it saves allocating and faulting in a new array each time).
 
     Returns B as an array of the points' shape; with ``gradient=True`` a tuple ``(B, G)``
     with ``G[n, i, j] = dB_i/dx_j`` [T/m]. The values are those ``magsep field --points``
@@ -139,12 +141,12 @@ def field(
     ``fibres[1].radius`` or ``points[7]``.
     """
     pts, single = _points(points)
-    out = _magsep.field(_fibre_dicts(fibres), pts, external, gradient)
     if single:
-        if gradient:
-            return out[0][0], out[1][0]
-        return out[0]
-    return out
+        res = _magsep.field(_fibre_dicts(fibres), pts, external, gradient, None)
+        if out is not None:
+            np.copyto(out, res[0] if gradient else res)
+        return (res[0][0], res[1][0]) if gradient else res[0]
+    return _magsep.field(_fibre_dicts(fibres), pts, external, gradient, out)
 
 
 def field_scene_text(

@@ -30,6 +30,7 @@ def field(
     points: np.ndarray,
     external: Union[None, Sequence[float], Mapping[str, Any]] = None,
     gradient: bool = False,
+    out: Optional[np.ndarray] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]: ...
 def field_scene_text(
     fibres: Any, external: Union[None, Sequence[float], Mapping[str, Any]] = None

@@ -96,16 +96,50 @@ pub fn field_scene_text(
     Ok(text)
 }
 
-/// B \[T\] at `points` (an (N, 3) array \[m\]) as an (N, 3) float64 array; with `gradient`, a
-/// tuple (B, G) where G\[n, i, j\] = ∂B_i/∂x_j \[T/m\].
+/// The (N, 3) float64 output array: `out` when given (C-contiguous, writeable, of that shape),
+/// else a new one.
+fn output<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    n: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let Some(out) = out.filter(|o| !o.is_none()) else {
+        return Ok(PyArray2::<f64>::zeros(py, [n, 3], false));
+    };
+    let out = out
+        .cast::<PyArray2<f64>>()
+        .map_err(|_| {
+            crate::key_error(
+                py,
+                "out",
+                format!("expected a float64 array of shape ({n}, 3)"),
+            )
+        })?
+        .clone();
+    if out.shape() != [n, 3] || !out.is_c_contiguous() {
+        return Err(crate::key_error(
+            py,
+            "out",
+            format!(
+                "expected a C-contiguous float64 array of shape ({n}, 3), got shape {:?}",
+                out.shape()
+            ),
+        ));
+    }
+    Ok(out)
+}
+
+/// B \[T\] at `points` (an (N, 3) array \[m\]) as an (N, 3) float64 array (written into `out`
+/// when given); with `gradient`, a tuple (B, G) where G\[n, i, j\] = ∂B_i/∂x_j \[T/m\].
 #[pyfunction]
-#[pyo3(signature = (fibres, points, external=None, gradient=false))]
+#[pyo3(signature = (fibres, points, external=None, gradient=false, out=None))]
 pub fn field<'py>(
     py: Python<'py>,
     fibres: &Bound<'py, PyAny>,
     points: &Bound<'py, PyAny>,
     external: Option<&Bound<'py, PyAny>>,
     gradient: bool,
+    out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scene = field_scene(fibres, external)?;
     // the array itself when it is already C-contiguous float64 (no copy)
@@ -142,10 +176,13 @@ pub fn field<'py>(
         ));
     }
     let n = array.shape()[0];
-    let b = PyArray2::<f64>::zeros(py, [n, 3], false);
-    // SAFETY: `b` was just created here and is not shared with anyone.
-    let b_out = unsafe { b.as_slice_mut() }
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let b = output(py, out, n)?;
+    let mut b_rw = b
+        .try_readwrite()
+        .map_err(|e| crate::key_error(py, "out", format!("cannot be written: {e}")))?;
+    let b_out = b_rw
+        .as_slice_mut()
+        .map_err(|e| crate::key_error(py, "out", format!("not contiguous: {e}")))?;
     let pts = as_points(xyz);
     if gradient {
         let g = PyArray3::<f64>::zeros(py, [n, 3, 3], false);
@@ -154,9 +191,11 @@ pub fn field<'py>(
             .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
         let (rows, _) = g_out.as_chunks_mut::<9>();
         py.detach(|| gradient_values(&scene, pts, as_points_mut(b_out), rows));
+        drop(b_rw);
         Ok(PyTuple::new(py, [b.into_any(), g.into_any()])?.into_any())
     } else {
         py.detach(|| field_values(&scene, pts, as_points_mut(b_out)));
+        drop(b_rw);
         Ok(b.into_any())
     }
 }

@@ -82,6 +82,24 @@ def test_point_layouts_give_the_same_values():
     assert np.array_equal(magsep.field([], pts, external=[0.0, 0.0, 0.5]), np.tile([0.0, 0.0, 0.5], (64, 1)))
 
 
+def test_out_receives_b_and_bad_out_is_refused():
+    f = magsep.Cylinder(radius=300e-6, half_length=6e-3, magnetisation=(0, 0, 985e3))
+    pts = random_points(2000, [1e-3, 1e-3, 8e-3], 5)
+    want = magsep.field([f], pts)
+    out = np.full((2000, 3), np.nan)
+    got = magsep.field([f], pts, out=out)
+    assert got is out and np.array_equal(bits(out), bits(want))
+    b, g = magsep.field([f], pts, gradient=True, out=out)
+    assert b is out and g.shape == (2000, 3, 3)
+    for bad in [np.zeros((1999, 3)), np.zeros((2000, 3), dtype=np.float32), np.zeros((3, 2000)).T, [[0.0] * 3] * 2000, pts]:
+        with pytest.raises(ValueError, match="out"):
+            magsep.field([f], pts, out=bad)
+    readonly = np.zeros((2000, 3))
+    readonly.setflags(write=False)
+    with pytest.raises(ValueError, match="out"):
+        magsep.field([f], pts, out=readonly)
+
+
 GOOD = {"kind": "cylinder", "radius": 1e-4, "half_length": 1e-3, "axis": [0, 0, 1], "magnetisation": [0, 0, 1e6]}
 
 
