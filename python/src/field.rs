@@ -116,12 +116,13 @@ fn output<'py>(
             )
         })?
         .clone();
-    if out.shape() != [n, 3] || !out.is_c_contiguous() {
+    let aligned: bool = out.getattr("flags")?.getattr("aligned")?.extract()?;
+    if out.shape() != [n, 3] || !out.is_c_contiguous() || !aligned {
         return Err(crate::key_error(
             py,
             "out",
             format!(
-                "expected a C-contiguous float64 array of shape ({n}, 3), got shape {:?}",
+                "expected a C-contiguous, aligned float64 array of shape ({n}, 3), got shape {:?}",
                 out.shape()
             ),
         ));
@@ -142,10 +143,10 @@ pub fn field<'py>(
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scene = field_scene(fibres, external)?;
-    // the array itself when it is already C-contiguous float64 (no copy)
+    // the array itself when it is already C-contiguous, aligned float64 (no copy)
     let array = py
         .import("numpy")?
-        .call_method1("ascontiguousarray", (points, "float64"))
+        .call_method1("require", (points, "float64", "CA"))
         .map_err(|e| {
             crate::key_error(
                 py,

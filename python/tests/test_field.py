@@ -78,6 +78,12 @@ def test_point_layouts_give_the_same_values():
     one = magsep.field(f, pts[5])
     assert one.shape == (3,) and np.array_equal(bits(one), bits(b[5]))
     assert magsep.field([f], np.zeros((0, 3))).shape == (0, 3)
+    # contiguous but unaligned float64 (a buffer at an odd offset): copied, same values
+    raw = bytearray(pts.nbytes + 1)
+    unaligned = np.frombuffer(raw, dtype=np.float64, count=pts.size, offset=1).reshape(64, 3)
+    unaligned[...] = pts
+    assert not unaligned.flags.aligned and unaligned.flags.c_contiguous
+    assert np.array_equal(bits(magsep.field([f], unaligned)), bits(b))
     # a uniform external field alone is B_ext everywhere
     assert np.array_equal(magsep.field([], pts, external=[0.0, 0.0, 0.5]), np.tile([0.0, 0.0, 0.5], (64, 1)))
 
