@@ -3,6 +3,7 @@
 mod buffering;
 mod channels;
 mod damage;
+mod seek;
 mod stream;
 
 use crate::proto::{ParticleStateWire, state_schema};
