@@ -36,7 +36,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 pub use crate::error::{SceneError, SceneErrors, SpawnError};
-pub use fibre_pack::PackSpec;
+pub use fibre_pack::{MAX_PACKED_FIBRES, PackSpec};
 pub use fibre_packing::FibrePackingSpec;
 pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use pipeline::{

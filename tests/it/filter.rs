@@ -64,10 +64,7 @@ fn a_packed_column_fills_its_tube_at_the_target_and_follows_the_seed() {
             center,
             axis,
             ..
-        } = f
-        else {
-            panic!("{f:?}")
-        };
+        } = f;
         assert_eq!(*radius, 200e-6);
         assert!((half_length - (0.8e-3 + 2.0 / 3.0 * 200e-6)).abs() < 1e-15);
         for end in [-0.8e-3, 0.8e-3] {

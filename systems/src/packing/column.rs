@@ -92,7 +92,7 @@ pub fn pack_rod_column(spec: &RodColumn, config: &PackingConfig) -> Result<Packe
         .map(|i| particle_stream(spec.seed, i))
         .collect();
     let mut state = random_insertion(&bodies, empty, &mut rngs).map_err(|e| e.to_string())?;
-    let mut reduced = config.clone();
+    let mut reduced = *config;
     reduced.initial_packing_fraction = spec.initial_packing_fraction;
     let p = DriverParams::from_config(&reduced, d);
     let mut list = NeighbourList::new(MCM_SKIN);
