@@ -55,6 +55,9 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
     let others: Vec<usize> = (0..sweep.axes.len())
         .filter(|k| !group.contains(k))
         .collect();
+    // the series are named by the first axis of each other group (its zipped partners move
+    // with it)
+    let named: Vec<bool> = others.iter().map(|&k| leads(sweep, k)).collect();
     let mut series: BTreeMap<Vec<usize>, BTreeMap<usize, Vec<f64>>> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.status == "ok") {
         let Some(y) = r.number(c).filter(|y| y.is_finite()) else {
@@ -83,8 +86,9 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
         let name = if others.is_empty() {
             c_name.clone()
         } else {
-            (others.iter().zip(&key))
-                .map(|(&k, &v)| {
+            (others.iter().zip(&key).zip(&named))
+                .filter(|(_, named)| **named)
+                .map(|((&k, &v), _)| {
                     format!(
                         "{}={}",
                         sweep.axes[k].name,
@@ -106,14 +110,22 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
     Some(chart)
 }
 
-/// Write every chart into `dir` (`<collected>__vs__<axis>.svg`); returns the files.
+/// Whether axis `k` is the first of its zipped group (or in none).
+fn leads(sweep: &Sweep, k: usize) -> bool {
+    (sweep.groups.iter())
+        .find(|g| g.contains(&k))
+        .is_none_or(|g| g.first() == Some(&k))
+}
+
+/// Write every chart into `dir` (`<collected>__vs__<axis>.svg`, against the first axis of each
+/// zipped group only: its partners give the same chart); returns the files.
 ///
 /// # Errors
 /// A write failure, naming the file.
 pub fn write_charts(sweep: &Sweep, rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut files = Vec::new();
     for c in 0..sweep.collect.len() {
-        for a in 0..sweep.axes.len() {
+        for a in (0..sweep.axes.len()).filter(|&a| leads(sweep, a)) {
             let Some(chart) = chart(sweep, rows, c, a) else {
                 continue;
             };
@@ -124,7 +136,10 @@ pub fn write_charts(sweep: &Sweep, rows: &[Row], dir: &Path) -> Result<Vec<PathB
                 slug(&sweep.collect[c].0),
                 slug(&sweep.axes[a].name)
             ));
-            write_svg(&path, &chart.to_svg(720.0, 480.0))
+            // room for long series names in the legend (about 7 px per character)
+            let longest = chart.series.iter().map(|s| s.name.chars().count()).max();
+            let width = (720.0 + 7.0 * longest.unwrap_or(0).saturating_sub(30) as f64).min(1400.0);
+            write_svg(&path, &chart.to_svg(width, 480.0))
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
             files.push(path);
         }
