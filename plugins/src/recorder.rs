@@ -241,13 +241,14 @@ pub fn record_now(world: &mut World) {
                 .map(|c| c.0.clone())
         });
     let mut rec = world.resource_mut::<Recorder>();
+    let step = frame.step;
     let result = rec
         .writer
         .as_mut()
-        .map(|w| w.write_frame(&frame, colours.as_deref()));
+        .map(|w| w.write_frame_owned(frame, colours));
     match result {
-        Some(Err(e)) => rec.fail(format!("frame at step {}: {e}", frame.step)),
-        _ => rec.last_step = Some(frame.step),
+        Some(Err(e)) => rec.fail(format!("frame at step {step}: {e}")),
+        _ => rec.last_step = Some(step),
     }
     if let Some(mut t) = world.get_resource_mut::<RecordTiming>() {
         t.seconds += started.elapsed().as_secs_f64();

@@ -21,6 +21,7 @@ use foxglove::messages::SceneUpdate;
 use glam::DVec3;
 use mcap::records::{MessageHeader, Metadata};
 use queue::QueuedFrame;
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -271,8 +272,27 @@ impl RecordingWriter {
         frame: &ParticleFrame,
         colours: Option<&[[f32; 4]]>,
     ) -> Result<(), RecordError> {
-        let n = particle_count(frame)?;
-        if let Some(c) = colours
+        self.write_frame_cow(Cow::Borrowed(frame), colours.map(Cow::Borrowed))
+    }
+
+    /// As [`write_frame`](Self::write_frame), taking the frame and its colours: a small frame
+    /// of a buffered writer is then queued as it is instead of copied (see
+    /// [`buffer_frames`](Self::buffer_frames)). The file's bytes are the same.
+    pub fn write_frame_owned(
+        &mut self,
+        frame: ParticleFrame,
+        colours: Option<Vec<[f32; 4]>>,
+    ) -> Result<(), RecordError> {
+        self.write_frame_cow(Cow::Owned(frame), colours.map(Cow::Owned))
+    }
+
+    fn write_frame_cow(
+        &mut self,
+        frame: Cow<'_, ParticleFrame>,
+        colours: Option<Cow<'_, [[f32; 4]]>>,
+    ) -> Result<(), RecordError> {
+        let n = particle_count(&frame)?;
+        if let Some(c) = &colours
             && c.len() != n
         {
             return Err(RecordError::InvalidInput {
@@ -286,11 +306,12 @@ impl RecordingWriter {
         if let Some(e) = self.deferred_error.take() {
             return Err(e);
         }
-        if self.queue_frame(frame, colours, n) {
+        if self.queues(n) {
+            self.queue_frame(frame.into_owned(), colours.map(Cow::into_owned), n);
             return self.after_frame();
         }
         self.drain_queue()?;
-        self.encode_frame(frame, colours)?;
+        self.encode_frame(&frame, colours.as_deref())?;
         self.after_frame()
     }
 
