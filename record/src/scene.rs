@@ -356,10 +356,13 @@ fn static_entities(decor: &SceneDecor, stamp: Option<Timestamp>) -> Vec<SceneEnt
 pub(crate) struct SceneCache {
     /// The static entities (backdrop, fibres); `None` once the decoration changed.
     statics: Option<Vec<Vec<u8>>>,
-    /// The entities drawn from the box edges (outline, walls), with the edges' bit patterns
-    /// and the walls they were built for.
-    boxed: Option<([u64; 3], Option<Walls>, Vec<Vec<u8>>)>,
+    /// The entities drawn from the box edges (outline, walls).
+    boxed: Option<BoxedEntities>,
 }
+
+/// The encoded entities drawn from the box edges, with the edges' bit patterns and the walls
+/// they were built for.
+type BoxedEntities = ([u64; 3], Option<Walls>, Vec<Vec<u8>>);
 
 impl SceneCache {
     /// Forget the static entities (the backdrop or the fibres changed).

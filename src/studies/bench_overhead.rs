@@ -8,9 +8,13 @@
 //!   multi-threaded executor for comparison. Rows `framework_step`: `particles`, `executor`,
 //!   `steps`, `us_per_step`, `us_per_particle_step` (best of 3 repetitions).
 //! * [`bench_recording`]: for each pipeline's representative shipped scene, the same steps with
-//!   and without the scene's own recording (`record.every`, written to a temporary file). Rows
-//!   `recording_overhead`: the wall times, the time spent writing frames (measured inside the
-//!   recorder, [`RecordTiming`]) and closing the file, and `overhead_fraction`: that time over
+//!   and without the scene's own recording (`record.every`, written to a temporary file), side
+//!   by side in 5 rounds (quick: 1) that alternate which run goes first. Rows
+//!   `recording_overhead`: `wall_ratio`, the median over the rounds of recorded / plain wall
+//!   time (the first and last frame and closing the file included; `wall_ratio_min`,
+//!   `wall_ratio_max` its spread), the median wall times, the time spent writing frames
+//!   (measured inside the recorder, [`RecordTiming`]) and closing the file, and
+//!   `overhead_fraction`: that time over
 //!   the time of the steps, extrapolated to the scene's full run (`frames_full_run` frames:
 //!   one every `every` steps plus the first and the last) where the pipeline knows its length
 //!   (else over the timed window): `frames_overhead_fraction` counts the frames only,
@@ -216,6 +220,22 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
     })
 }
 
+/// Median of `v` (not empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Rounds of the side-by-side comparison (quick: one).
+fn recording_rounds(quick: bool) -> usize {
+    if quick { 1 } else { 5 }
+}
+
 /// `magsep bench recording [--json] [--quick]`: rows `recording_overhead` (module docs).
 ///
 /// # Errors
@@ -233,9 +253,36 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
             continue;
         }
         let scene = parse_scene(text, &registry).map_err(|e| runtime(name)(e.to_string()))?;
-        let plain = window(&scene, steps, None)?;
-        let rec = window(&scene, steps, Some(&path))?;
-        let _ = std::fs::remove_file(&path);
+        // rounds alternate which run goes first, so that a drift of the machine's load
+        // weighs on both
+        let mut pairs = Vec::new();
+        for round in 0..recording_rounds(quick) {
+            let (plain, rec) = if round % 2 == 0 {
+                let plain = window(&scene, steps, None)?;
+                (plain, window(&scene, steps, Some(&path))?)
+            } else {
+                let rec = window(&scene, steps, Some(&path))?;
+                (window(&scene, steps, None)?, rec)
+            };
+            let _ = std::fs::remove_file(&path);
+            pairs.push((plain, rec));
+        }
+        let ratios: Vec<f64> = pairs
+            .iter()
+            .map(|(p, r)| r.wall_s / p.wall_s.max(1e-12))
+            .collect();
+        let wall_ratio = median(ratios.clone());
+        let sum = |f: fn(&Window) -> f64| pairs.iter().map(|(_, r)| f(r)).sum::<f64>();
+        let rec = Window {
+            wall_s: sum(|w| w.wall_s),
+            steps: pairs.iter().map(|(_, r)| r.steps).sum(),
+            record_s: sum(|w| w.record_s),
+            frames: pairs.iter().map(|(_, r)| r.frames).sum(),
+            finish_s: sum(|w| w.finish_s) / pairs.len() as f64,
+            bytes: pairs.last().map_or(0, |(_, r)| r.bytes),
+        };
+        let plain_s = median(pairs.iter().map(|(p, _)| p.wall_s).collect());
+        let rec_s = median(pairs.iter().map(|(_, r)| r.wall_s).collect());
         let every = {
             let sim = Simulation::builder(&scene)
                 .build()
@@ -245,7 +292,8 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                 .get_resource::<RecordEvery>()
                 .map_or(100, |r| r.0)
         };
-        let recording_s = rec.record_s + rec.finish_s;
+        let rounds = pairs.len() as f64;
+        let recording_s = rec.record_s + rec.finish_s * rounds;
         let step_s = (rec.wall_s - recording_s).max(1e-12) / rec.steps.max(1) as f64;
         let frame_s = rec.record_s / rec.frames.max(1) as f64;
         let total = scene.pipeline.as_ref().and_then(|p| p.total_steps(&scene));
@@ -258,17 +306,24 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                 let cost = frames as f64 * frame_s;
                 (frames, (cost + rec.finish_s) / run, cost / run)
             }
-            _ => (rec.frames, window_fraction, window_frames),
+            _ => (
+                rec.frames / pairs.len() as u64,
+                window_fraction,
+                window_frames,
+            ),
         };
         emit(
             &mut rows,
             as_json,
             json!({"name": "recording_overhead", "scene": name,
                    "pipeline": scene.pipeline.as_ref().map(|p| p.name()),
-                   "threads": threads(), "every": every, "steps": rec.steps,
-                   "wall_plain_s": plain.wall_s, "wall_recorded_s": rec.wall_s,
-                   "wall_ratio": rec.wall_s / plain.wall_s.max(1e-12),
-                   "frames": rec.frames, "bytes": rec.bytes,
+                   "threads": threads(), "every": every,
+                   "steps": rec.steps / pairs.len() as u64, "rounds": pairs.len(),
+                   "wall_plain_s": plain_s, "wall_recorded_s": rec_s,
+                   "wall_ratio": wall_ratio,
+                   "wall_ratio_min": ratios.iter().copied().fold(f64::INFINITY, f64::min),
+                   "wall_ratio_max": ratios.iter().copied().fold(0.0, f64::max),
+                   "frames": rec.frames / pairs.len() as u64, "bytes": rec.bytes,
                    "record_s_per_frame": frame_s, "finish_s": rec.finish_s,
                    "step_s": step_s,
                    "window_overhead_fraction": window_fraction,

@@ -19,7 +19,7 @@ fn particle(id: u64) -> (ParticleId, Position, Orientation, Shape) {
         ParticleId(id),
         Position(DVec3::new(f, 2.0 * f, -f)),
         Orientation(DQuat::from_rotation_z(0.1 * f)),
-        if id % 2 == 0 {
+        if id.is_multiple_of(2) {
             Shape::Sphere {
                 radius: 1e-3 * (1.0 + f),
             }
