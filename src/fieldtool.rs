@@ -112,33 +112,76 @@ pub fn csv_header(gradient: bool) -> String {
     h
 }
 
-/// One CSV line per point: position \[m\], B \[T\] and (with `gradient`) `∂B_i/∂x_j` [T/m] in the
-/// order `dbx_dx, dbx_dy, dbx_dz, dby_dx, ...`. Shortest round-trip formatting.
-pub fn field_rows(scene: &FieldScene, points: &[DVec3], gradient: bool) -> Vec<String> {
-    points
-        .par_chunks(1024)
-        .flat_map_iter(|chunk| {
-            // B of the whole chunk at once (the four-lane kernel), unless gradients are asked
-            let mut b = vec![DVec3::ZERO; if gradient { 0 } else { chunk.len() }];
-            if !gradient {
-                total_field_batch(&scene.sources, scene.b_ext, chunk, scene.tolerance, &mut b);
-            }
-            chunk.iter().enumerate().map(move |(k, &p)| {
-                let mut row = format!("{},{},{}", p.x, p.y, p.z);
-                if gradient {
-                    let g = scene.gradient(p);
-                    row.push_str(&format!(",{},{},{}", g.b.x, g.b.y, g.b.z));
-                    let rows = g.grad_b.transpose(); // column i = ∇B_i
-                    for i in 0..3 {
-                        let r = rows.col(i);
-                        row.push_str(&format!(",{},{},{}", r.x, r.y, r.z));
-                    }
-                } else {
-                    let b = b[k];
-                    row.push_str(&format!(",{},{},{}", b.x, b.y, b.z));
+/// Points per parallel work item of [`field_values`] and [`gradient_values`] (the chunks
+/// start at point 0 whatever the thread count, so the values do not depend on it).
+pub const FIELD_CHUNK: usize = 1024;
+
+/// B \[T\] at every point \[m\] into `b` (`b[k]` for `points[k]`), in parallel chunks of
+/// [`FIELD_CHUNK`] points through the four-lane kernel: the values `magsep field --points`
+/// writes. Only `min(points.len(), b.len())` values are written.
+pub fn field_values(scene: &FieldScene, points: &[DVec3], b: &mut [DVec3]) {
+    b.par_chunks_mut(FIELD_CHUNK)
+        .zip(points.par_chunks(FIELD_CHUNK))
+        .for_each(|(out, chunk)| {
+            let n = out.len().min(chunk.len());
+            total_field_batch(
+                &scene.sources,
+                scene.b_ext,
+                &chunk[..n],
+                scene.tolerance,
+                &mut out[..n],
+            );
+        });
+}
+
+/// B \[T\] and its gradient \[T/m\] at every point \[m\]: `b[k]`, and `grad[k][3 * i + j]` =
+/// `∂B_i/∂x_j` (row-major), in parallel chunks of [`FIELD_CHUNK`] points: the values
+/// `magsep field --points --gradient` writes. Only as many points as the shortest of the
+/// three slices are evaluated.
+pub fn gradient_values(
+    scene: &FieldScene,
+    points: &[DVec3],
+    b: &mut [DVec3],
+    grad: &mut [[f64; 9]],
+) {
+    b.par_chunks_mut(FIELD_CHUNK)
+        .zip(grad.par_chunks_mut(FIELD_CHUNK))
+        .zip(points.par_chunks(FIELD_CHUNK))
+        .for_each(|((b, grad), chunk)| {
+            for ((b, grad), &p) in b.iter_mut().zip(grad.iter_mut()).zip(chunk) {
+                let g = scene.gradient(p);
+                *b = g.b;
+                // grad_b's row i is ∇B_i (its transpose's column i)
+                let rows = g.grad_b.transpose();
+                for i in 0..3 {
+                    grad[3 * i..3 * i + 3].copy_from_slice(&rows.col(i).to_array());
                 }
-                row
-            })
+            }
+        });
+}
+
+/// One CSV line per point: position \[m\], B \[T\] and (with `gradient`) `∂B_i/∂x_j` [T/m] in the
+/// order `dbx_dx, dbx_dy, dbx_dz, dby_dx, ...` (the values of [`field_values`] and
+/// [`gradient_values`]). Shortest round-trip formatting.
+pub fn field_rows(scene: &FieldScene, points: &[DVec3], gradient: bool) -> Vec<String> {
+    let mut b = vec![DVec3::ZERO; points.len()];
+    let mut grad = vec![[0.0; 9]; if gradient { points.len() } else { 0 }];
+    if gradient {
+        gradient_values(scene, points, &mut b, &mut grad);
+    } else {
+        field_values(scene, points, &mut b);
+    }
+    points
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut row = format!("{},{},{},{},{},{}", p.x, p.y, p.z, b[k].x, b[k].y, b[k].z);
+            if let Some(g) = grad.get(k) {
+                for v in g {
+                    row.push_str(&format!(",{v}"));
+                }
+            }
+            row
         })
         .collect()
 }
@@ -276,5 +319,85 @@ pub fn attractive_force(scene: &FieldScene, p: DVec3, law: &MomentModel) -> f64 
     match nearest {
         Some(s) if f.dot(s.closest_point(p) - p) <= 0.0 => 0.0,
         _ => f.length(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn three_fibres() -> FieldScene {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/fibres_three.toml"
+        ))
+        .unwrap();
+        FieldScene::from_scene(&crate::scene::parse_scene(&text, &Default::default()).unwrap())
+    }
+
+    /// Points spread through and around the fibres, over several chunks and a partial one.
+    fn points(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64;
+                DVec3::new(
+                    1e-3 * (0.37 * t).sin(),
+                    1e-3 * (0.23 * t).cos(),
+                    2e-3 * (0.011 * t).sin(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn field_values_match_the_one_point_field_and_not_the_thread_count() {
+        let fs = three_fibres();
+        let p = points(2 * FIELD_CHUNK + 77);
+        let on = |threads: usize| {
+            let mut b = vec![DVec3::NAN; p.len()];
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| field_values(&fs, &p, &mut b));
+            b
+        };
+        let b = on(2);
+        assert_eq!(b, on(1));
+        // the four-lane kernel against the one-point reference (they may differ in the last bit)
+        for (k, (&p, b)) in p.iter().zip(&b).enumerate() {
+            let want = fs.b(p);
+            assert!(
+                (*b - want).length() <= 1e-12 * want.length(),
+                "point {k}: {b} against {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn gradient_values_are_the_one_point_gradient_row_major() {
+        let fs = three_fibres();
+        let p = points(FIELD_CHUNK + 5);
+        let mut b = vec![DVec3::NAN; p.len()];
+        let mut grad = vec![[f64::NAN; 9]; p.len()];
+        gradient_values(&fs, &p, &mut b, &mut grad);
+        for (k, &p) in p.iter().enumerate() {
+            let g = fs.gradient(p);
+            assert_eq!(b[k], g.b);
+            for i in 0..3 {
+                for j in 0..3 {
+                    // grad_b's row i, column j: ∂B_i/∂x_j
+                    assert_eq!(
+                        grad[k][3 * i + j],
+                        g.grad_b.row(i)[j],
+                        "point {k} ({i}, {j})"
+                    );
+                }
+            }
+        }
+        // shorter outputs: only their points, no panic
+        let mut short = vec![DVec3::ZERO; 3];
+        field_values(&fs, &p, &mut short);
+        assert_eq!(short[2], fs.b(p[2]));
     }
 }

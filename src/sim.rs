@@ -157,6 +157,14 @@ impl Simulation {
             app.add_boxed_plugin(p.clone());
         }
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
+        if !scene.packed_columns.is_empty() {
+            let columns = Value::Array(scene.packed_columns.clone());
+            app.world.insert_resource(PackedColumns(columns));
+            app.world
+                .get_resource_or_insert_with(SummaryExtras::default)
+                .0
+                .push(("fibre_packings".into(), packed_columns));
+        }
         if let Some(path) = &options.record {
             let writer = open_recording(&mut app, path, scene, pipeline.as_ref(), seed)?;
             let every = app
@@ -319,6 +327,15 @@ pub fn partial(error: SimError, mut summary: Value) -> SimError {
 /// A function giving one summary key from the final world (`None`: leave the key out).
 pub type SummaryFn = fn(&World) -> Option<Value>;
 
+/// The `[[fibre_packings]]` columns packed when the scene was read (a resource).
+#[derive(Resource)]
+struct PackedColumns(Value);
+
+/// The summary's `fibre_packings`.
+fn packed_columns(world: &World) -> Option<Value> {
+    world.get_resource::<PackedColumns>().map(|p| p.0.clone())
+}
+
 /// Keys plugins add to the run's summary: (key, function of the final world) (a resource).
 #[derive(Resource, Default, Clone)]
 pub struct SummaryExtras(pub Vec<(String, SummaryFn)>);
@@ -420,9 +437,25 @@ pub fn run_scene(
     progress: &dyn Progress,
 ) -> Result<Value, SimError> {
     let pipeline = scene.pipeline.clone().ok_or(SimError::NothingToRun)?;
-    if let Some(result) = pipeline.run(scene, options, progress) {
-        return result;
+    let mut result = match pipeline.run(scene, options, progress) {
+        Some(result) => result,
+        None => run_steps(scene, options, progress, pipeline.as_ref()),
+    };
+    // what `[[fibre_packings]] pack` packed, also where the pipeline ran its own way
+    if let (Ok(Value::Object(map)), false) = (&mut result, scene.packed_columns.is_empty()) {
+        map.entry("fibre_packings")
+            .or_insert_with(|| Value::Array(scene.packed_columns.clone()));
     }
+    result
+}
+
+/// [`run_scene`] for a pipeline without its own `run`: one simulation, step by step.
+fn run_steps(
+    scene: &Scene,
+    options: &RunOptions,
+    progress: &dyn Progress,
+    pipeline: &dyn Pipeline,
+) -> Result<Value, SimError> {
     if let Some(n) = pipeline.total_steps(scene) {
         progress.set_total(n);
     }

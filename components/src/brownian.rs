@@ -257,6 +257,11 @@ pub struct BrownianConfig {
     /// particles do not move. Default zero (quiescent liquid).
     #[serde(default)]
     pub flow: [f64; 3],
+    /// Whether the liquid flows around the fibres (potential flow past each fibre, see
+    /// `magsep_systems::brownian::fibre_flow`) rather than through them with the mean velocity
+    /// everywhere. Default false.
+    #[serde(default)]
+    pub flow_around_fibres: bool,
 }
 
 impl BrownianConfig {

@@ -30,6 +30,9 @@ mod run;
 pub mod signals;
 mod sweep;
 
+/// The output-file rules of every command (also for the Python package's `record=`).
+pub use output::{Input, check_file};
+
 /// A CLI failure with its exit code (2 bad input, 1 runtime failure, 130/143 interrupted). An
 /// empty message is not printed (a closed standard output ends the command quietly).
 #[derive(Debug)]

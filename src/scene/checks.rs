@@ -112,7 +112,19 @@ fn value_at<'a>(value: &'a toml::Value, segments: &[String]) -> Option<&'a toml:
 /// Inside the table or array `at`, where serde could not say, the key of the value an
 /// `invalid type`/`invalid value`/`unknown variant` message is about (when it is unique).
 fn culprit(at: &toml::Value, message: &str) -> Option<String> {
-    if message.starts_with("unknown variant") {
+    if let Some(rest) = message.strip_prefix("unknown variant `") {
+        // the string key that holds the variant's name (e.g. `around_fibres = "stokes"`
+        // beside a good `kind`), else `kind`
+        let name = rest.split('`').next().unwrap_or("");
+        let mut hits = Vec::new();
+        leaves(at, String::new(), &mut |key, v| {
+            if v.as_str() == Some(name) {
+                hits.push(key.to_string());
+            }
+        });
+        if let [one] = hits.as_slice() {
+            return Some(one.clone());
+        }
         return at.as_table()?.contains_key("kind").then(|| "kind".into());
     }
     let what = message

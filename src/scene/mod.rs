@@ -17,6 +17,7 @@
 //! ```
 
 pub mod checks;
+mod fibre_pack;
 mod fibre_packing;
 mod fibres;
 pub mod memory;
@@ -35,6 +36,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 pub use crate::error::{SceneError, SceneErrors, SpawnError};
+pub use fibre_pack::PackSpec;
 pub use fibre_packing::FibrePackingSpec;
 pub use fibres::{ExternalFieldSection, FibreSpec};
 pub use pipeline::{
@@ -79,6 +81,10 @@ pub struct Scene {
     pub section: Option<SceneSection>,
     /// `[[fibres]]`, in file order.
     pub fibres: Vec<FibreSpec>,
+    /// What the `[[fibre_packings]]` entries with `pack` packed (one JSON object each: entry
+    /// index, fibres, packing fraction reached, height \[m\], compression steps, jammed), added
+    /// to the run's summary as `fibre_packings`.
+    pub packed_columns: Vec<serde_json::Value>,
     /// `[external_field]`.
     pub external_field: Option<ExternalFieldSection>,
     /// `[[particles]]`, in file order (particle ids follow this order).

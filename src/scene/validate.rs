@@ -383,11 +383,15 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
     let before = errors.len();
     let typed_all =
         fibres.len() == entries("fibres") && fibre_packings.len() == entries("fibre_packings");
+    let mut packed_columns = Vec::new();
+    let scene_seed = simulation.as_ref().map_or(0, |s| s.seed);
     for (i, spec) in &fibre_packings {
         let first = fibres.len();
-        for f in super::fibre_packing::expand(*i, spec, &mut errors) {
+        let (expanded, report) = super::fibre_packing::expand(*i, spec, scene_seed, &mut errors);
+        for f in expanded {
             fibres.push((first, f));
         }
+        packed_columns.extend(report);
     }
     let fibres_valid = typed_all && errors.len() == before;
     let fibre_specs: Vec<FibreSpec> = fibres.iter().map(|(_, f)| f.clone()).collect();
@@ -481,6 +485,7 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
         pipeline,
         section,
         fibres: fibres.into_iter().map(|(_, f)| f).collect(),
+        packed_columns,
         external_field,
         particles: particles.into_iter().map(|(_, g)| g).collect(),
         record,

@@ -13,6 +13,7 @@ mod cli;
 mod cli_field;
 mod common;
 mod field_reference;
+mod filter;
 mod fluid_charts;
 mod graceful_stop;
 mod liquid;

@@ -57,6 +57,7 @@ fn world(n: u64, dt: f64, steps: u64, control: StepControl) -> SimApp {
         observe_every: steps.max(1),
         field_patch: None,
         flow: [0.0; 3],
+        flow_around_fibres: false,
     });
     w.insert_resource(ExternalField {
         flux_density: DVec3::ZERO,

@@ -4,6 +4,7 @@
 mod chunk;
 mod layout;
 mod scan;
+mod seek;
 mod source;
 mod stream;
 mod summary;

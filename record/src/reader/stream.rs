@@ -2,9 +2,9 @@
 
 use super::chunk::{ReaderLimits, decompress, split_records};
 use super::layout::{End, Layout, MESSAGE_HEAD_LEN, MetadataRecord, Unit, message_head};
+use super::seek::{FrameIndex, decode_frame};
 use super::source::Source;
 use super::{ChannelInfo, scan, summary};
-use crate::proto::ParticleStateWire;
 use crate::{ParticleFrame, RecordError, RecordingMetadata, STATE_TOPIC};
 use mcap::records::op;
 use std::fs::File;
@@ -95,7 +95,8 @@ pub struct RecordingReader<R = BufReader<File>> {
     src: Source<R>,
     path: PathBuf,
     limits: ReaderLimits,
-    layout: Layout,
+    pub(super) layout: Layout,
+    pub(super) frame_index: FrameIndex,
 }
 
 impl RecordingReader<BufReader<File>> {
@@ -178,6 +179,7 @@ impl<R: Read + Seek> RecordingReader<R> {
             path,
             limits,
             layout,
+            frame_index: FrameIndex::default(),
         })
     }
 
@@ -284,12 +286,7 @@ impl<R: Read + Seek> RecordingReader<R> {
     /// Iterates the `/state` frames, decoded lazily. Yields an error and stops at a damaged
     /// record or an undecodable frame.
     pub fn frames(&mut self) -> Frames<'_, R> {
-        let encoding = self
-            .layout
-            .channels
-            .values()
-            .find(|c| c.topic == STATE_TOPIC && c.message_encoding != "protobuf")
-            .map(|c| c.message_encoding.clone());
+        let encoding = self.state_encoding_error();
         Frames {
             messages: self.messages(Some(STATE_TOPIC)),
             bad_encoding: encoding,
@@ -306,7 +303,7 @@ impl<R: Read + Seek> RecordingReader<R> {
     }
 
     /// Reads the messages of `unit` accepted by `accept`.
-    fn load(
+    pub(super) fn load(
         &mut self,
         unit: &Unit,
         accept: &dyn Fn(u16) -> bool,
@@ -407,7 +404,7 @@ impl<R> std::fmt::Debug for RecordingReader<R> {
 }
 
 /// A copy of an error of the scan, to yield from an iterator.
-fn duplicate(e: &RecordError) -> RecordError {
+pub(super) fn duplicate(e: &RecordError) -> RecordError {
     match e {
         RecordError::Io { path, source } => RecordError::Io {
             path: path.clone(),
@@ -495,24 +492,10 @@ impl<R: Read + Seek> Iterator for Frames<'_, R> {
         if self.done {
             return None;
         }
-        let item = match self.messages.next()? {
-            Err(e) => Err(e),
-            Ok(m) => match &self.bad_encoding {
-                Some(enc) => Err(RecordError::Decode {
-                    detail: format!(
-                        "{STATE_TOPIC} has message encoding {enc:?}, expected \"protobuf\""
-                    ),
-                }),
-                None => ParticleStateWire::decode_payload(&m.data)
-                    .and_then(ParticleStateWire::into_frame)
-                    .map_err(|e| RecordError::Decode {
-                        detail: format!(
-                            "{STATE_TOPIC} frame #{} (in the record at byte {}): {e}",
-                            self.count, m.offset
-                        ),
-                    }),
-            },
-        };
+        let item = self
+            .messages
+            .next()?
+            .and_then(|m| decode_frame(&m, self.count, self.bad_encoding.as_deref()));
         match &item {
             Ok(_) => self.count += 1,
             Err(_) => self.done = true,

@@ -4,6 +4,7 @@ mod buffering;
 mod channels;
 mod damage;
 mod encoding;
+mod seek;
 mod stream;
 
 use crate::proto::{ParticleStateWire, state_schema};

@@ -35,8 +35,13 @@
 //! packed beds (Carman). Assumed: laminar, steady, incompressible flow through a homogeneous,
 //! isotropic packing (no wall channelling, no alignment), fibres wet and fixed.
 //!
-//! What both neglect: the flow field around each fibre (no stagnation points, no boundary
-//! layer: the liquid moves with u everywhere, through the fibres' surfaces too) and any
+//! Either kind takes `around_fibres = "potential"`: the liquid then flows around each fibre as
+//! 2D potential flow past a cylinder, added to u (Watson's model of a magnetic filter's wire;
+//! `magsep_systems::brownian::fibre_flow` states its limits: truncated at 8 fibre radii, ends
+//! not modelled, perturbations of close fibres added). Without it (`none`, the default) both
+//! neglect the flow field around each fibre (no stagnation points, no boundary
+//! layer: the liquid moves with u everywhere, through the fibres' surfaces too, so that every
+//! particle on a path through a fibre is captured at any speed) and any
 //! variation of the velocity along the column.
 
 use glam::DVec3;
@@ -63,6 +68,9 @@ pub enum BrownianFlow {
     Uniform {
         /// The interstitial velocity u \[m/s\].
         velocity: [f64; 3],
+        /// Through the fibres (`none`, default) or around them (`potential`).
+        #[serde(default)]
+        around_fibres: AroundFibres,
     },
     /// Darcy's law through a fibre packing with a Kozeny-Carman permeability.
     Darcy {
@@ -78,7 +86,22 @@ pub enum BrownianFlow {
         /// Kozeny-Carman constant C_KC. Default 5. Range (0, 1000].
         #[serde(default, skip_serializing_if = "Option::is_none")]
         kozeny_carman: Option<f64>,
+        /// Through the fibres (`none`, default) or around them (`potential`).
+        #[serde(default)]
+        around_fibres: AroundFibres,
     },
+}
+
+/// How the liquid meets the fibres.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AroundFibres {
+    /// The mean velocity everywhere, through the fibres too.
+    #[default]
+    None,
+    /// Potential flow past each fibre on top of the mean velocity (Watson's model of a
+    /// magnetic filter's wire; see `magsep_systems::brownian::fibre_flow`).
+    Potential,
 }
 
 /// Kozeny-Carman permeability \[m²\] of a packing of cylinders: `k = (1 − φ)³ ν² / (C φ²)`
@@ -99,17 +122,24 @@ pub fn kozeny_carman_permeability(phi: f64, diameter: f64, length: Option<f64>, 
 }
 
 impl BrownianFlow {
+    /// Whether the liquid flows around the fibres (`around_fibres = "potential"`).
+    pub fn around_fibres(&self) -> bool {
+        let (Self::Uniform { around_fibres, .. } | Self::Darcy { around_fibres, .. }) = self;
+        *around_fibres == AroundFibres::Potential
+    }
+
     /// The mean interstitial velocity u \[m/s\] that advects the particles, in a liquid of
     /// viscosity `viscosity` \[Pa s\].
     pub fn velocity(&self, viscosity: f64) -> DVec3 {
         match *self {
-            Self::Uniform { velocity } => DVec3::from_array(velocity),
+            Self::Uniform { velocity, .. } => DVec3::from_array(velocity),
             Self::Darcy {
                 pressure_gradient,
                 packing_fraction: phi,
                 fibre_diameter,
                 fibre_length,
                 kozeny_carman,
+                ..
             } => {
                 let c = kozeny_carman.unwrap_or(DEFAULT_KOZENY_CARMAN);
                 let k = kozeny_carman_permeability(phi, fibre_diameter, fibre_length, c);
@@ -140,7 +170,7 @@ fn finite_vector(path: &str, v: &[f64; 3], unit: &str, errors: &mut Vec<SceneErr
 pub fn validate_flow(flow: &BrownianFlow, viscosity: f64, errors: &mut Vec<SceneError>) {
     let before = errors.len();
     let key = match flow {
-        BrownianFlow::Uniform { velocity } => {
+        BrownianFlow::Uniform { velocity, .. } => {
             finite_vector("brownian.flow.velocity", velocity, "[m/s]", errors);
             "velocity"
         }
@@ -150,6 +180,7 @@ pub fn validate_flow(flow: &BrownianFlow, viscosity: f64, errors: &mut Vec<Scene
             fibre_diameter,
             fibre_length,
             kozeny_carman,
+            ..
         } => {
             let p = "brownian.flow";
             finite_vector(
@@ -237,6 +268,7 @@ mod tests {
             fibre_diameter: 400e-6,
             fibre_length: Some(7e-3),
             kozeny_carman: None,
+            around_fibres: AroundFibres::None,
         };
         let u = flow.velocity(eta);
         let k = kozeny_carman_permeability(phi, 400e-6, Some(7e-3), 5.0);
@@ -259,6 +291,7 @@ mod tests {
             fibre_diameter: 400e-6,
             fibre_length: None,
             kozeny_carman: None,
+            around_fibres: AroundFibres::None,
         };
         assert!(check(darcy(1e4, 0.3)).is_empty());
         assert_eq!(check(darcy(1e4, 0.95)), ["brownian.flow.packing_fraction"]);
@@ -269,6 +302,7 @@ mod tests {
         assert_eq!(check(darcy(1e9, 0.3)), ["brownian.flow.pressure_gradient"]);
         let uniform = |v: f64| BrownianFlow::Uniform {
             velocity: [0.0, v, 0.0],
+            around_fibres: AroundFibres::Potential,
         };
         assert!(check(uniform(1.0)).is_empty());
         assert_eq!(check(uniform(1.01)), ["brownian.flow.velocity"]);

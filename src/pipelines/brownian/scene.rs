@@ -134,6 +134,7 @@ impl BrownianSection {
             flow: self.flow.map_or([0.0; 3], |f| {
                 f.velocity(self.viscosity.unwrap_or(1e-3)).to_array()
             }),
+            flow_around_fibres: self.flow.is_some_and(|f| f.around_fibres()),
         }
     }
 

@@ -10,6 +10,7 @@ use magsep_components::shape::Shape;
 use crate::forces::{ExternalForces, ParticleState};
 
 use super::contact::{remove_overlaps, swept_capture_cached};
+use super::fibre_flow::FibreFlow;
 use super::hydro::Mobility;
 use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
 use super::stepper::Dynamics;
@@ -60,6 +61,8 @@ pub struct PipelineDynamics<'a> {
     /// drift after the mobility, so with hydrodynamic interactions too each particle moves
     /// with u on top of `μ F`).
     pub flow: DVec3,
+    /// The flow's perturbation around the fibres (None: the mean flow everywhere).
+    pub flow_field: Option<&'a FibreFlow>,
     /// Hydrodynamic interactions (None: free draining).
     pub hydro: Option<&'a HydroState>,
     /// Neighbour lists of the pair forces (cached across evaluations).
@@ -115,15 +118,24 @@ impl PipelineDynamics<'_> {
             .collect()
     }
 
-    /// Velocities from forces `f` (masked to the free particles), plus the liquid's mean
-    /// velocity [`PipelineDynamics::flow`] for the free particles.
-    pub fn velocities(&self, f: &[DVec3], v: &mut [DVec3]) {
+    /// The liquid's velocity at `x` \[m/s\]: the mean flow and, with a flow field, the
+    /// fibres' perturbation.
+    pub fn liquid(&self, x: DVec3) -> DVec3 {
+        match self.flow_field {
+            Some(ff) => ff.velocity(self.flow, x),
+            None => self.flow,
+        }
+    }
+
+    /// Velocities at positions `x` from forces `f` (masked to the free particles), plus the
+    /// liquid's velocity ([`PipelineDynamics::liquid`]) for the free particles.
+    pub fn velocities(&self, x: &[DVec3], f: &[DVec3], v: &mut [DVec3]) {
         match self.hydro {
             None => {
                 for i in 0..f.len() {
                     v[i] = if self.mobile[i] {
                         f[i] / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
-                            + self.flow
+                            + self.liquid(x[i])
                     } else {
                         DVec3::ZERO
                     };
@@ -136,7 +148,7 @@ impl PipelineDynamics<'_> {
                 v.fill(DVec3::ZERO);
                 for (k, &i) in h.rows.iter().enumerate() {
                     if self.mobile[i] {
-                        v[i] = vs[k] + self.flow;
+                        v[i] = vs[k] + self.liquid(x[i]);
                     }
                 }
             }
@@ -176,7 +188,7 @@ impl Dynamics for PipelineDynamics<'_> {
                 *fi += *fk;
             }
         }
-        self.velocities(&f, v);
+        self.velocities(x, &f, v);
     }
 
     fn at_time(&mut self, t: f64) {
@@ -312,7 +324,8 @@ impl LocalDynamics for PipelineDynamics<'_> {
         }
         for (fi, &i) in f.iter().zip(active) {
             v[i] = if self.mobile[i] {
-                *fi / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]) + self.flow
+                *fi / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
+                    + self.liquid(x[i])
             } else {
                 DVec3::ZERO
             };

@@ -6,6 +6,7 @@
 pub mod cells;
 pub mod contact;
 pub mod dynamics;
+pub mod fibre_flow;
 pub mod hydro;
 pub mod model;
 pub mod pair;

@@ -19,6 +19,7 @@ use magsep_components::prelude::*;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::dynamics::{HydroState, PipelineDynamics};
+use super::fibre_flow::{FibreFlow, FlowFibre};
 use super::hydro::{Mobility, MobilityMethod, MobilityOptions, auto_method};
 use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
@@ -60,6 +61,8 @@ pub struct BrownianWorkspace {
     pub hydro: Option<HydroState>,
     /// Resolved mobility method.
     pub method: MobilityMethod,
+    /// The liquid's flow around the fibres (`BrownianConfig::flow_around_fibres` with a flow).
+    pub flow_field: Option<FibreFlow>,
 }
 
 impl BrownianWorkspace {
@@ -195,6 +198,19 @@ pub fn init_brownian_workspace(world: &mut World) {
         lists: PairLists::default(),
         hydro: None,
         method,
+        flow_field: (config.flow_around_fibres && config.flow != [0.0; 3]).then(|| {
+            FibreFlow::new(
+                fibres
+                    .iter()
+                    .map(|f| FlowFibre {
+                        center: f.center,
+                        axis: f.axis,
+                        radius: f.radius,
+                        half_length: f.half_length,
+                    })
+                    .collect(),
+            )
+        }),
     });
     let step = world
         .get_resource::<StepClock>()
@@ -418,6 +434,7 @@ pub fn integrate_brownian(
         viscosity: config.viscosity,
         kt: config.kt(),
         flow: DVec3::from_array(config.flow),
+        flow_field: ws.flow_field.as_ref(),
         hydro: ws.hydro.as_ref(),
         lists: &mut ws.lists,
         start_moments: &ws.moments,
@@ -430,8 +447,8 @@ pub fn integrate_brownian(
         failure: None,
     };
     let mut v0 = vec![DVec3::ZERO; n];
-    dynamics.velocities(&net, &mut v0);
     let mut x = std::mem::take(&mut ws.positions);
+    dynamics.velocities(&x, &net, &mut v0);
     match config.step_control {
         // multirate needs per-particle noise and drift: free draining, no hard cores
         StepControl::Multirate {

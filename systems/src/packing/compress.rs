@@ -218,11 +218,27 @@ pub fn compression_step(
     list: &mut NeighbourList,
     rng: &mut impl Rng,
 ) {
+    compression_step_to(p, st, state, list, rng, None);
+}
+
+/// [`compression_step`] that compresses no further than the packing fraction `target` (the
+/// volume step is cut to reach it exactly); `None`: no limit.
+pub fn compression_step_to(
+    p: &DriverParams,
+    st: &mut PackingStatus,
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    rng: &mut impl Rng,
+    target: Option<f64>,
+) {
     if st.stopped.is_some() {
         return;
     }
     let saved = state.clone();
-    let dv = next_volume_step(p, st, state);
+    let mut dv = next_volume_step(p, st, state);
+    if let Some(phi) = target {
+        dv = dv.min(state.container_volume() - state.particle_volume() / phi);
+    }
     compress(state, list, dv);
     let out = run_removal(p, state, list, rng);
     settle_step(p, st, dv, out, || {

@@ -8,6 +8,7 @@
 //! The ECS glue is in [`systems`].
 
 pub mod body;
+pub mod column;
 pub mod compress;
 pub mod contact;
 pub mod external;

@@ -70,6 +70,7 @@ fn run(threads: usize, n: usize) -> (Vec<DVec3>, BrownianStats) {
                 viscosity: 1e-3,
                 kt,
                 flow: DVec3::ZERO,
+                flow_field: None,
                 hydro: None,
                 lists: &mut lists,
                 start_moments: &[],
