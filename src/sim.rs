@@ -294,7 +294,7 @@ impl Simulation {
                 if let Some(reason) = summary.get("interrupted_by").and_then(Value::as_str) {
                     w.write_interrupted(reason)?;
                 }
-                w.write_summary(&summary.to_string())?;
+                w.write_summary_value(summary)?;
                 w.finish()?;
             }
         }

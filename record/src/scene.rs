@@ -210,12 +210,25 @@ fn entity(id: &str, stamp: Option<Timestamp>) -> SceneEntity {
 }
 
 /// The entities that change from frame to frame: particles, box outline, walls.
+#[cfg(test)]
 fn frame_entities(
     frame: &ParticleFrame,
     colours: Option<&[[f32; 4]]>,
     decor: &SceneDecor,
     stamp: Option<Timestamp>,
 ) -> Vec<SceneEntity> {
+    let mut entities = vec![particles_entity(frame, colours, decor, stamp)];
+    entities.extend(box_entities(frame.box_edges, decor.walls, stamp));
+    entities
+}
+
+/// The particles entity of `frame`.
+fn particles_entity(
+    frame: &ParticleFrame,
+    colours: Option<&[[f32; 4]]>,
+    decor: &SceneDecor,
+    stamp: Option<Timestamp>,
+) -> SceneEntity {
     let mut spheres = Vec::with_capacity(frame.ids.len());
     let mut cylinders = Vec::new();
     for i in 0..frame.ids.len() {
@@ -253,19 +266,24 @@ fn frame_entities(
             spheres.push(sphere(c - h * axis));
         }
     }
-    let entity = |id: &str| entity(id, stamp);
-    let particles = SceneEntity {
+    SceneEntity {
         spheres,
         cylinders,
-        ..entity(PARTICLES_ENTITY)
-    };
+        ..entity(PARTICLES_ENTITY, stamp)
+    }
+}
+
+/// The entities drawn from the box edges `edges` alone: the box outline (none for zero
+/// edges) and the walls.
+fn box_entities(edges: DVec3, walls: Option<Walls>, stamp: Option<Timestamp>) -> Vec<SceneEntity> {
+    let entity = |id: &str| entity(id, stamp);
     let outline = SceneEntity {
         lines: vec![LinePrimitive {
             r#type: line_primitive::Type::LineList as i32,
             pose: pose(DVec3::ZERO, DQuat::IDENTITY),
             thickness: BOX_LINE_PX,
             scale_invariant: true,
-            points: box_edge_points(frame.box_edges),
+            points: box_edge_points(edges),
             color: Some(Color {
                 r: BOX_COLOUR[0],
                 g: BOX_COLOUR[1],
@@ -276,13 +294,13 @@ fn frame_entities(
         }],
         ..entity(BOX_ENTITY)
     };
-    let mut entities = vec![particles];
+    let mut entities = Vec::new();
     // an unbounded run (the brownian pipeline) records zero edges: no outline
-    if frame.box_edges != DVec3::ZERO {
+    if edges != DVec3::ZERO {
         entities.push(outline);
     }
-    if let Some(w) = decor.walls {
-        entities.push(wall_entity(w, frame.box_edges, entity(WALLS_ENTITY)));
+    if let Some(w) = walls {
+        entities.push(wall_entity(w, edges, entity(WALLS_ENTITY)));
     }
     entities
 }
@@ -332,17 +350,41 @@ fn static_entities(decor: &SceneDecor, stamp: Option<Timestamp>) -> Vec<SceneEnt
     entities
 }
 
-/// [`scene_update`] encoded into `out` (cleared first), byte for byte as prost encodes it,
-/// with the static entities (backdrop, fibres) encoded once into `cache` and reused: they
-/// are most of the bytes of a small frame (a magnet's colour map, a filter's fibres). prost
-/// writes a message's fields in tag order, so an entity's encoding is its timestamp (tag 1)
-/// followed by the encoding of the same entity without one.
+/// Entity encodings that frames reuse, without their timestamps (see
+/// [`encode_scene_update`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SceneCache {
+    /// The static entities (backdrop, fibres); `None` once the decoration changed.
+    statics: Option<Vec<Vec<u8>>>,
+    /// The entities drawn from the box edges (outline, walls).
+    boxed: Option<BoxedEntities>,
+}
+
+/// The encoded entities drawn from the box edges, with the edges' bit patterns and the walls
+/// they were built for.
+type BoxedEntities = ([u64; 3], Option<Walls>, Vec<Vec<u8>>);
+
+impl SceneCache {
+    /// Forget the static entities (the backdrop or the fibres changed).
+    pub(crate) fn clear_statics(&mut self) {
+        self.statics = None;
+    }
+}
+
+/// [`scene_update`] encoded into `out` (cleared first), byte for byte as prost encodes it.
+/// Only the particles entity is encoded anew at every frame: the static entities (backdrop,
+/// fibres) are encoded once into `cache`, and the box outline and walls whenever the box
+/// edges (bit for bit) or the walls change; they are most of the bytes of a small frame (a
+/// magnet's colour map, a filter's fibres, the outline's 24 points). prost writes a message's
+/// fields in tag order, so an entity's encoding is its timestamp (tag 1) followed by the
+/// encoding of the same entity without one, and a scene update's is the concatenation of its
+/// entities' (tag 2).
 pub(crate) fn encode_scene_update(
     frame: &ParticleFrame,
     colours: Option<&[[f32; 4]]>,
     decor: &SceneDecor,
     log_time_ns: u64,
-    cache: &mut Option<Vec<Vec<u8>>>,
+    cache: &mut SceneCache,
     out: &mut Vec<u8>,
 ) {
     use prost::Message;
@@ -351,10 +393,19 @@ pub(crate) fn encode_scene_update(
     out.clear();
     SceneUpdate {
         deletions: Vec::new(),
-        entities: frame_entities(frame, colours, decor, Some(stamp)),
+        entities: vec![particles_entity(frame, colours, decor, Some(stamp))],
     }
     .encode_raw(out);
-    let bodies = cache.get_or_insert_with(|| {
+    let e = frame.box_edges;
+    let key = [e.x.to_bits(), e.y.to_bits(), e.z.to_bits()];
+    if !matches!(&cache.boxed, Some((k, w, _)) if *k == key && *w == decor.walls) {
+        let bodies = box_entities(e, decor.walls, None)
+            .iter()
+            .map(Message::encode_to_vec)
+            .collect();
+        cache.boxed = Some((key, decor.walls, bodies));
+    }
+    let statics = cache.statics.get_or_insert_with(|| {
         static_entities(decor, None)
             .iter()
             .map(Message::encode_to_vec)
@@ -365,7 +416,8 @@ pub(crate) fn encode_scene_update(
         ..Default::default()
     }
     .encode_to_vec();
-    for body in bodies.iter() {
+    let boxed = cache.boxed.iter().flat_map(|(_, _, b)| b.iter());
+    for body in boxed.chain(statics.iter()) {
         encode_key(2, WireType::LengthDelimited, out);
         encode_varint((stamp_bytes.len() + body.len()) as u64, out);
         out.extend_from_slice(&stamp_bytes);

@@ -8,14 +8,19 @@
 //!   multi-threaded executor for comparison. Rows `framework_step`: `particles`, `executor`,
 //!   `steps`, `us_per_step`, `us_per_particle_step` (best of 3 repetitions).
 //! * [`bench_recording`]: for each pipeline's representative shipped scene, the same steps with
-//!   and without the scene's own recording (`record.every`, written to a temporary file). Rows
-//!   `recording_overhead`: the wall times, the time spent writing frames (measured inside the
-//!   recorder, [`RecordTiming`]) and closing the file, and `overhead_fraction`: that time over
+//!   and without the scene's own recording (`record.every`, written to a temporary file), side
+//!   by side in 5 rounds (quick: 1) that alternate which run goes first. Rows
+//!   `recording_overhead`: `wall_ratio`, the median over the rounds of recorded / plain wall
+//!   time (building the simulation, opening the file, the first and last frame and closing the
+//!   file included; `build_s` the building alone; `wall_ratio_min`,
+//!   `wall_ratio_max` its spread), the median wall times, the time spent writing frames
+//!   (measured inside the recorder, [`RecordTiming`]) and closing the file, and
+//!   `overhead_fraction`: that time over
 //!   the time of the steps, extrapolated to the scene's full run (`frames_full_run` frames:
 //!   one every `every` steps plus the first and the last) where the pipeline knows its length
 //!   (else over the timed window): `frames_overhead_fraction` counts the frames only,
-//!   `overhead_fraction` also the one-off closing of the file (`finish_s`: summary, footer and
-//!   the `fsync`, which dominates runs of a few hundredths of a second).
+//!   `overhead_fraction` also the one-off closing of the file (`finish_s`: the summary
+//!   record, the summary section and the footer).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -164,10 +169,13 @@ const RECORDING_SCENES: &[(&str, &str, u64, u64)] = &[
     ),
 ];
 
-/// One timed window: wall time of `steps` steps (with the first and last frame and closing the
-/// recording when `record` is set), and the recorder's own time.
+/// One timed window: wall time of building the simulation and `steps` steps (with opening the
+/// recording, the first and last frame and closing the recording when `record` is set), and
+/// the recorder's own time.
 struct Window {
     wall_s: f64,
+    /// Building the simulation (in `wall_s`).
+    build_s: f64,
     steps: u64,
     record_s: f64,
     frames: u64,
@@ -176,6 +184,8 @@ struct Window {
 }
 
 fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window, BenchError> {
+    // the window opens with building the simulation, which opens the recording
+    let t0 = Instant::now();
     let mut b = Simulation::builder(scene);
     if let Some(path) = record {
         b = b.record(path.clone());
@@ -183,8 +193,8 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
     let mut sim = b
         .build()
         .map_err(|e| runtime("recording scene")(e.to_string()))?;
+    let build_s = t0.elapsed().as_secs_f64();
     sim.app.world.insert_resource(RecordTiming::default());
-    let t0 = Instant::now();
     record_now(&mut sim.app.world);
     let mut done = 0;
     while done < steps && !sim.is_finished() {
@@ -208,12 +218,29 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
         .map_or(0, |m| m.len());
     Ok(Window {
         wall_s: t0.elapsed().as_secs_f64(),
+        build_s,
         steps: done,
         record_s: timing.seconds,
         frames: timing.frames,
         finish_s: if record.is_some() { finish_s } else { 0.0 },
         bytes,
     })
+}
+
+/// Median of `v` (not empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Rounds of the side-by-side comparison (quick: one).
+fn recording_rounds(quick: bool) -> usize {
+    if quick { 1 } else { 5 }
 }
 
 /// `magsep bench recording [--json] [--quick]`: rows `recording_overhead` (module docs).
@@ -233,9 +260,37 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
             continue;
         }
         let scene = parse_scene(text, &registry).map_err(|e| runtime(name)(e.to_string()))?;
-        let plain = window(&scene, steps, None)?;
-        let rec = window(&scene, steps, Some(&path))?;
-        let _ = std::fs::remove_file(&path);
+        // rounds alternate which run goes first, so that a drift of the machine's load
+        // weighs on both
+        let mut pairs = Vec::new();
+        for round in 0..recording_rounds(quick) {
+            let (plain, rec) = if round % 2 == 0 {
+                let plain = window(&scene, steps, None)?;
+                (plain, window(&scene, steps, Some(&path))?)
+            } else {
+                let rec = window(&scene, steps, Some(&path))?;
+                (window(&scene, steps, None)?, rec)
+            };
+            let _ = std::fs::remove_file(&path);
+            pairs.push((plain, rec));
+        }
+        let ratios: Vec<f64> = pairs
+            .iter()
+            .map(|(p, r)| r.wall_s / p.wall_s.max(1e-12))
+            .collect();
+        let wall_ratio = median(ratios.clone());
+        let sum = |f: fn(&Window) -> f64| pairs.iter().map(|(_, r)| f(r)).sum::<f64>();
+        let rec = Window {
+            wall_s: sum(|w| w.wall_s),
+            build_s: sum(|w| w.build_s),
+            steps: pairs.iter().map(|(_, r)| r.steps).sum(),
+            record_s: sum(|w| w.record_s),
+            frames: pairs.iter().map(|(_, r)| r.frames).sum(),
+            finish_s: sum(|w| w.finish_s) / pairs.len() as f64,
+            bytes: pairs.last().map_or(0, |(_, r)| r.bytes),
+        };
+        let plain_s = median(pairs.iter().map(|(p, _)| p.wall_s).collect());
+        let rec_s = median(pairs.iter().map(|(_, r)| r.wall_s).collect());
         let every = {
             let sim = Simulation::builder(&scene)
                 .build()
@@ -245,12 +300,14 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                 .get_resource::<RecordEvery>()
                 .map_or(100, |r| r.0)
         };
-        let recording_s = rec.record_s + rec.finish_s;
-        let step_s = (rec.wall_s - recording_s).max(1e-12) / rec.steps.max(1) as f64;
+        let rounds = pairs.len() as f64;
+        let recording_s = rec.record_s + rec.finish_s * rounds;
+        let stepping_s = (rec.wall_s - rec.build_s - recording_s).max(1e-12);
+        let step_s = stepping_s / rec.steps.max(1) as f64;
         let frame_s = rec.record_s / rec.frames.max(1) as f64;
         let total = scene.pipeline.as_ref().and_then(|p| p.total_steps(&scene));
-        let window_fraction = recording_s / (rec.wall_s - recording_s).max(1e-12);
-        let window_frames = rec.record_s / (rec.wall_s - recording_s).max(1e-12);
+        let window_fraction = recording_s / stepping_s;
+        let window_frames = rec.record_s / stepping_s;
         let (frames_full, fraction_full, frames_fraction) = match total {
             Some(t) if t > 0 => {
                 let frames = t / every.max(1) + 2;
@@ -258,17 +315,25 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                 let cost = frames as f64 * frame_s;
                 (frames, (cost + rec.finish_s) / run, cost / run)
             }
-            _ => (rec.frames, window_fraction, window_frames),
+            _ => (
+                rec.frames / pairs.len() as u64,
+                window_fraction,
+                window_frames,
+            ),
         };
         emit(
             &mut rows,
             as_json,
             json!({"name": "recording_overhead", "scene": name,
                    "pipeline": scene.pipeline.as_ref().map(|p| p.name()),
-                   "threads": threads(), "every": every, "steps": rec.steps,
-                   "wall_plain_s": plain.wall_s, "wall_recorded_s": rec.wall_s,
-                   "wall_ratio": rec.wall_s / plain.wall_s.max(1e-12),
-                   "frames": rec.frames, "bytes": rec.bytes,
+                   "threads": threads(), "every": every,
+                   "steps": rec.steps / pairs.len() as u64, "rounds": pairs.len(),
+                   "wall_plain_s": plain_s, "wall_recorded_s": rec_s,
+                   "build_s": rec.build_s / rounds,
+                   "wall_ratio": wall_ratio,
+                   "wall_ratio_min": ratios.iter().copied().fold(f64::INFINITY, f64::min),
+                   "wall_ratio_max": ratios.iter().copied().fold(0.0, f64::max),
+                   "frames": rec.frames / pairs.len() as u64, "bytes": rec.bytes,
                    "record_s_per_frame": frame_s, "finish_s": rec.finish_s,
                    "step_s": step_s,
                    "window_overhead_fraction": window_fraction,

@@ -5,3 +5,4 @@ mod brownian_user_forces;
 mod fluid_user_forces;
 mod force_registration;
 mod packing_user_forces;
+mod recorder_gather;

@@ -198,14 +198,13 @@ fn queued_frames_encode_to_the_messages_of_unqueued_ones() {
         radius: 0.1,
         half_length: 1.0,
     };
-    let write = |buffered: bool| {
-        let path = TempFile::new(if buffered {
-            "queued.mcap"
-        } else {
-            "unqueued.mcap"
-        });
+    // odd frames with colours
+    let colours = |k: usize, n: usize| (k % 2 == 1).then(|| vec![[0.1, 0.2, 0.3, 1.0]; n]);
+    // 0: each frame encoded at once; 1: queued (copied); 2: queued (moved, `write_frame_owned`)
+    let write = |mode: usize| {
+        let path = TempFile::new(&format!("queued{mode}.mcap"));
         let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
-        if buffered {
+        if mode > 0 {
             w.buffer_frames(Some(FrameBuffering {
                 max_bytes: u64::MAX,
                 max_wait: Duration::from_secs(3600),
@@ -215,16 +214,25 @@ fn queued_frames_encode_to_the_messages_of_unqueued_ones() {
             if k == 70 {
                 w.set_fibres(vec![fibre]);
             }
-            w.write_frame(f, None).unwrap();
+            let c = colours(k, f.ids.len());
+            if mode == 2 {
+                w.write_frame_owned(f.clone(), c).unwrap();
+            } else {
+                w.write_frame(f, c.as_deref()).unwrap();
+            }
         }
         assert_eq!(w.frames_written(), frames.len() as u64);
         w.finish().unwrap();
         std::fs::read(&path).unwrap()
     };
-    let (queued, unqueued) = (write(true), write(false));
+    let (unqueued, queued, owned) = (write(0), write(1), write(2));
     let (a, b) = (messages(&queued), messages(&unqueued));
     assert_eq!(a.len(), 2 * frames.len());
     assert!(a == b, "queued frames gave other messages");
+    assert!(
+        messages(&owned) == b,
+        "frames queued by value gave other messages"
+    );
     // the fibres are drawn from frame 70 on, not before
     let scene = |k: usize| &a[2 * k + 1].3;
     assert!(scene(71).len() > scene(69).len());

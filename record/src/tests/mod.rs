@@ -3,6 +3,7 @@
 mod buffering;
 mod channels;
 mod damage;
+mod encoding;
 mod seek;
 mod stream;
 
@@ -552,42 +553,4 @@ fn record_scene_draws_the_backdrop() {
         .expect("backdrop entity");
     assert_eq!(b.cubes.len(), 1);
     assert_eq!(b.cubes[0].color.unwrap().a, f64::from(0.1f32));
-}
-
-/// The writer's encoder (static entities encoded once, timestamps spliced in) gives the bytes
-/// prost gives for the whole scene update, frame after frame with the cache reused, with
-/// walls, fibres, a backdrop and rods.
-#[test]
-fn cached_scene_encoding_equals_the_full_encoding_bit_for_bit() {
-    let decor = scene::SceneDecor {
-        backdrop: (0..7)
-            .map(|k| crate::BackdropCube {
-                center: DVec3::new(0.5, 0.5, 0.1 * k as f64),
-                size: DVec3::new(1.0, 1.0, 0.1),
-                colour: [0.9, 0.3, 0.2, 0.1],
-            })
-            .collect(),
-        fibres: vec![crate::FibreShape {
-            center: DVec3::new(0.2, 0.3, 0.4),
-            axis: DVec3::new(0.0, 1.0, 1.0),
-            radius: 0.05,
-            half_length: 0.3,
-        }],
-        walls: Some(crate::WallShape::Wedge { angle: 0.4 }),
-        ..Default::default()
-    };
-    let mut cache = None;
-    let mut fast = Vec::new();
-    for (k, frame) in random_frames(21, 4, true).iter().enumerate() {
-        let log_time = 1_000_000_007 * k as u64 + 3;
-        let mut full = Vec::new();
-        foxglove::Encode::encode(
-            &scene::scene_update(frame, None, &decor, log_time),
-            &mut full,
-        )
-        .unwrap();
-        scene::encode_scene_update(frame, None, &decor, log_time, &mut cache, &mut fast);
-        assert_eq!(fast, full, "frame {k}");
-    }
-    assert_eq!(cache.as_ref().map(Vec::len), Some(2));
 }

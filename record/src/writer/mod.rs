@@ -10,7 +10,7 @@ use crate::frame::{BackdropCube, FibreShape, WallShape};
 use crate::meta::metadata_entries;
 use crate::proto::{encode_state, particle_count, state_schema};
 use crate::reader::MAX_CHUNK_BYTES;
-use crate::scene::{SceneDecor, encode_scene_update};
+use crate::scene::{SceneCache, SceneDecor, encode_scene_update};
 use crate::{
     INTERRUPTED_METADATA_NAME, METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata,
     SCENE_TOPIC, STATE_TOPIC, SUMMARY_METADATA_NAME,
@@ -21,6 +21,7 @@ use foxglove::messages::SceneUpdate;
 use glam::DVec3;
 use mcap::records::{MessageHeader, Metadata};
 use queue::QueuedFrame;
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -71,6 +72,14 @@ pub fn log_time_ns(frame: &ParticleFrame) -> u64 {
     }
 }
 
+/// zstd level of the chunks. Level 1 (zstd's fastest positive level, `ZSTD_fast`) instead
+/// of the default 3 (`ZSTD_dfast`): its stream context takes ~0.7 MB instead of ~3 MB (a
+/// 512 KiB window instead of 2 MiB; hash tables of 32 KiB instead of 768 KiB, which zstd
+/// zeroes when the context is created), and it compresses a frame in about half the
+/// instructions. The data (mostly f64 words) compresses nearly as well; readers decompress
+/// any level.
+pub const COMPRESSION_LEVEL: u32 = 1;
+
 /// Writes a recording: MCAP with zstd-compressed chunks, channels [`STATE_TOPIC`] and
 /// [`SCENE_TOPIC`], metadata records [`METADATA_NAME`] and [`SUMMARY_METADATA_NAME`], plus the
 /// channels ([`add_channel`](Self::add_channel)) and metadata records
@@ -95,10 +104,12 @@ pub struct RecordingWriter {
     last_log_time: Option<u64>,
     /// Reused message encoding buffer.
     buf: Vec<u8>,
+    /// Reused encoding buffer of the scene updates.
+    scene_buf: Vec<u8>,
     /// Fibres, walls and particle shapes drawn in every scene update.
     decor: SceneDecor,
-    /// The encoded static entities of the scene (backdrop, fibres), built at the first frame.
-    static_scene: Option<Vec<Vec<u8>>>,
+    /// The encoded entities that frames reuse (backdrop, fibres; box outline, walls).
+    scene_cache: SceneCache,
     /// Channels added by plugins, in the order added.
     channels: Vec<AddedChannel>,
     /// Largest chunk a frame may take ([`MAX_CHUNK_BYTES`]; smaller in tests).
@@ -169,7 +180,8 @@ impl RecordingWriter {
             // Compress on the calling thread: the crate's default (a zstd worker per physical
             // core) hands every chunk to a worker and waits for it, which cost a one-particle
             // frame ~100 µs of thread wake-ups, more than the compression itself.
-            .compression_threads(0);
+            .compression_threads(0)
+            .compression_level(COMPRESSION_LEVEL);
         let mut writer = Self {
             mcap: None,
             path: path.to_path_buf(),
@@ -178,8 +190,9 @@ impl RecordingWriter {
             frames_written: 0,
             last_log_time: None,
             buf: Vec::new(),
+            scene_buf: Vec::new(),
             decor: SceneDecor::default(),
-            static_scene: None,
+            scene_cache: SceneCache::default(),
             channels: Vec::new(),
             max_chunk: MAX_CHUNK_BYTES,
             buffering: None,
@@ -259,8 +272,27 @@ impl RecordingWriter {
         frame: &ParticleFrame,
         colours: Option<&[[f32; 4]]>,
     ) -> Result<(), RecordError> {
-        let n = particle_count(frame)?;
-        if let Some(c) = colours
+        self.write_frame_cow(Cow::Borrowed(frame), colours.map(Cow::Borrowed))
+    }
+
+    /// As [`write_frame`](Self::write_frame), taking the frame and its colours: a small frame
+    /// of a buffered writer is then queued as it is instead of copied (see
+    /// [`buffer_frames`](Self::buffer_frames)). The file's bytes are the same.
+    pub fn write_frame_owned(
+        &mut self,
+        frame: ParticleFrame,
+        colours: Option<Vec<[f32; 4]>>,
+    ) -> Result<(), RecordError> {
+        self.write_frame_cow(Cow::Owned(frame), colours.map(Cow::Owned))
+    }
+
+    fn write_frame_cow(
+        &mut self,
+        frame: Cow<'_, ParticleFrame>,
+        colours: Option<Cow<'_, [[f32; 4]]>>,
+    ) -> Result<(), RecordError> {
+        let n = particle_count(&frame)?;
+        if let Some(c) = &colours
             && c.len() != n
         {
             return Err(RecordError::InvalidInput {
@@ -274,11 +306,12 @@ impl RecordingWriter {
         if let Some(e) = self.deferred_error.take() {
             return Err(e);
         }
-        if self.queue_frame(frame, colours, n) {
+        if self.queues(n) {
+            self.queue_frame(frame.into_owned(), colours.map(Cow::into_owned), n);
             return self.after_frame();
         }
         self.drain_queue()?;
-        self.encode_frame(frame, colours)?;
+        self.encode_frame(&frame, colours.as_deref())?;
         self.after_frame()
     }
 
@@ -294,13 +327,15 @@ impl RecordingWriter {
         // MCAP sequence numbers are u32; wrapping after 2^32 frames is harmless.
         let sequence = self.frames_written as u32;
 
-        let mut scene = Vec::new();
+        // both message buffers are kept between frames (a small frame's scene update is a
+        // few kB, which a new buffer reaches through several reallocations)
+        let mut scene = std::mem::take(&mut self.scene_buf);
         encode_scene_update(
             frame,
             colours,
             &self.decor,
             log_time,
-            &mut self.static_scene,
+            &mut self.scene_cache,
             &mut scene,
         );
         self.buf.clear();
@@ -308,6 +343,7 @@ impl RecordingWriter {
         // The frame's chunk holds both messages (record and message headers: 31 bytes each).
         let chunk = (self.buf.len() + scene.len() + 62) as u64;
         if chunk > self.max_chunk {
+            self.scene_buf = scene;
             return Err(RecordError::InvalidInput {
                 detail: format!(
                     "frame at step {} of {n} particles takes {chunk} bytes, more than the \
@@ -316,24 +352,45 @@ impl RecordingWriter {
                 ),
             });
         }
-        // a chunk never grows past what readers accept: flush the frames pending first
-        if self.pending > 0 && self.pending + chunk > self.max_chunk {
-            self.flush()?;
-        }
-        self.write_buf(self.state_channel, sequence, log_time)?;
-        self.buf = scene;
-        self.write_buf(self.scene_channel, sequence, log_time)?;
+        let result = self.write_frame_messages(&scene, chunk, sequence, log_time);
+        self.scene_buf = scene;
+        result?;
         self.pending += chunk;
         self.last_log_time = Some(log_time);
         self.frames_written += 1;
         Ok(())
     }
 
+    /// Write a frame's messages: `self.buf` on [`STATE_TOPIC`], `scene` on [`SCENE_TOPIC`]
+    /// (flushing the pending frames first if the frame's `chunk` bytes would make the open
+    /// chunk larger than readers accept); no flush.
+    fn write_frame_messages(
+        &mut self,
+        scene: &[u8],
+        chunk: u64,
+        sequence: u32,
+        time: u64,
+    ) -> Result<(), RecordError> {
+        // a chunk never grows past what readers accept: flush the frames pending first
+        if self.pending > 0 && self.pending + chunk > self.max_chunk {
+            self.flush()?;
+        }
+        self.write_buf(self.state_channel, sequence, time)?;
+        let header = MessageHeader {
+            channel_id: self.scene_channel,
+            sequence,
+            log_time: time,
+            publish_time: time,
+        };
+        let result = self.mcap().write_to_known_channel(&header, scene);
+        result.map_err(|e| self.write_error(e))
+    }
+
     /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
     pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
         self.drain_before_decor();
         self.decor.fibres = fibres;
-        self.static_scene = None;
+        self.scene_cache.clear_statics();
     }
 
     /// Hard walls to draw (entity `walls`, sized from each frame's box edges) in every
@@ -349,7 +406,7 @@ impl RecordingWriter {
     pub fn set_backdrop(&mut self, cubes: Vec<BackdropCube>) {
         self.drain_before_decor();
         self.decor.backdrop = cubes;
-        self.static_scene = None;
+        self.scene_cache.clear_statics();
     }
 
     /// Superquadric semi-axes per particle (frame order; zero for spheres and rods): such
@@ -369,6 +426,14 @@ impl RecordingWriter {
             }
         })?;
         let entries = BTreeMap::from([("summary".to_string(), summary_json.to_string())]);
+        self.write_metadata(SUMMARY_METADATA_NAME, entries)
+    }
+
+    /// As [`write_summary`](Self::write_summary) with the JSON text of `summary` (which, being
+    /// a `serde_json::Value`, needs no check: a run's summary of a few thousand numbers took
+    /// longer to parse again than to write).
+    pub fn write_summary_value(&mut self, summary: &serde_json::Value) -> Result<(), RecordError> {
+        let entries = BTreeMap::from([("summary".to_string(), summary.to_string())]);
         self.write_metadata(SUMMARY_METADATA_NAME, entries)
     }
 

@@ -25,23 +25,21 @@ pub(super) struct QueuedFrame {
 }
 
 impl RecordingWriter {
-    /// Queue `frame` (of `n` particles) if the writer buffers frames and the frame is small;
-    /// `false` if it must be encoded now.
+    /// Whether a frame of `n` particles is queued: the writer buffers frames and the frame
+    /// is small.
+    pub(super) fn queues(&self, n: usize) -> bool {
+        self.buffering.is_some() && n <= QUEUE_PARTICLES
+    }
+
+    /// Queue `frame` (of `n` particles) with its colours.
     pub(super) fn queue_frame(
         &mut self,
-        frame: &ParticleFrame,
-        colours: Option<&[[f32; 4]]>,
+        frame: ParticleFrame,
+        colours: Option<Vec<[f32; 4]>>,
         n: usize,
-    ) -> bool {
-        if self.buffering.is_none() || n > QUEUE_PARTICLES {
-            return false;
-        }
-        self.queued.push(QueuedFrame {
-            frame: frame.clone(),
-            colours: colours.map(<[_]>::to_vec),
-        });
+    ) {
+        self.queued.push(QueuedFrame { frame, colours });
         self.queued_particles += n;
-        true
     }
 
     /// After a frame was queued or written: encode the queue when it is full or a flush is
