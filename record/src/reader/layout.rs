@@ -132,6 +132,17 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
+    /// The ids of the channels on `topic` (`None`: all topics, no filter).
+    pub(crate) fn channel_ids(&self, topic: Option<&str>) -> Option<Vec<u16>> {
+        topic.map(|t| {
+            self.channels
+                .iter()
+                .filter(|(_, c)| c.topic == t)
+                .map(|(id, _)| *id)
+                .collect()
+        })
+    }
+
     pub(crate) fn schema(&mut self, body: &[u8]) -> Result<(), RecErr> {
         let mut c = Cursor::new(body);
         let id = c.u16("schema id")?;

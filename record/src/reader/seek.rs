@@ -71,14 +71,7 @@ impl<R: Read + Seek> RecordingReader<R> {
         topic: Option<&str>,
     ) -> Option<Result<Vec<RawMessage>, RecordError>> {
         let u = self.layout.units.get(unit)?.clone();
-        let wanted: Option<Vec<u16>> = topic.map(|t| {
-            self.layout
-                .channels
-                .iter()
-                .filter(|(_, c)| c.topic == t)
-                .map(|(id, _)| *id)
-                .collect()
-        });
+        let wanted = self.layout.channel_ids(topic);
         if let (
             Some(wanted),
             Unit::Chunk {

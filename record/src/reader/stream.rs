@@ -266,14 +266,7 @@ impl<R: Read + Seek> RecordingReader<R> {
     /// Iterates the messages on `topic` (all topics for `None`) in file order, one chunk in
     /// memory at a time. Yields an error and stops at a damaged or unreadable record.
     pub fn messages(&mut self, topic: Option<&str>) -> Messages<'_, R> {
-        let channels = topic.map(|t| {
-            self.layout
-                .channels
-                .iter()
-                .filter(|(_, c)| c.topic == t)
-                .map(|(id, _)| *id)
-                .collect()
-        });
+        let channels = self.layout.channel_ids(topic);
         Messages {
             reader: self,
             channels,
