@@ -1,6 +1,7 @@
 //! `magsep sweep`: resumable after a kill, shards merged equal the unsharded sweep byte for
 //! byte, partial merges, up-front validation of every point, the Slurm scripts (run here
-//! task by task with `bash`, as Slurm would), and a failing point recorded, not fatal.
+//! task by task with `bash`, as Slurm would), a failing point recorded, not fatal, and run
+//! again only with `--retry-failed`, and recordings written with `--record`.
 
 use crate::common::{magsep, stderr};
 use std::path::{Path, PathBuf};
@@ -450,4 +451,60 @@ linspace = { start = 1e-3, stop = 3e-3, num = 3 }
     assert_eq!(rows[0][..4], ["0", "1", "5e-8", "0.001"]);
     assert_eq!(rows[1][..4], ["1", "1", "1e-7", "0.001"]);
     assert_eq!(rows[5][..4], ["5", "3", "1e-7", "0.003"]);
+}
+
+#[test]
+fn failed_points_are_kept_until_retried_and_records_are_written_on_request() {
+    let dir = fresh("retry");
+    // point 0 runs; point 1 cannot place 20000 particles in its tiny box (fails at run time)
+    let text = "scene = \"base.toml\"\ncollect = [\"steps\"]\n[[axes]]\n\
+                path = \"particles[0].count\"\nvalues = [1, 20000]\n[[axes]]\n\
+                path = \"particles[0].placement.max\"\nvalues = [[1e-7, 1e-7, 1e-7]]\n";
+    let sweep = write_sweep(&dir, text);
+    let o_dir = out(&dir, "out");
+    let first = magsep(&["sweep", &sweep, "--out", &o_dir, "--quiet", "--record"]);
+    assert_eq!(first.status.code(), Some(1), "{}", stderr(&first));
+    let v = json(&first);
+    assert_eq!(
+        (v["ran"].as_u64(), v["failed"].as_u64()),
+        (Some(2), Some(1))
+    );
+    // --record: the finished point's recording, readable
+    let rec = Path::new(&o_dir).join("points/0/recording.mcap");
+    let info = magsep(&["info", rec.to_str().unwrap()]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    // a restart without --retry-failed runs nothing: the failure is kept
+    let again = magsep(&["sweep", &sweep, "--out", &o_dir, "--quiet"]);
+    let v = json(&again);
+    assert_eq!(
+        (v["ran"].as_u64(), v["skipped"].as_u64()),
+        (Some(0), Some(2)),
+        "{v}"
+    );
+    assert_eq!(v["failed"].as_u64(), Some(1), "{v}");
+    // --retry-failed runs the failed point again, and only it
+    let retry = magsep(&[
+        "sweep",
+        &sweep,
+        "--out",
+        &o_dir,
+        "--quiet",
+        "--retry-failed",
+    ]);
+    let v = json(&retry);
+    assert_eq!(
+        (v["ran"].as_u64(), v["skipped"].as_u64()),
+        (Some(1), Some(1)),
+        "{v}"
+    );
+    assert_eq!(
+        (v["ok"].as_u64(), v["failed"].as_u64()),
+        (Some(1), Some(1)),
+        "{v}"
+    );
+    // without --record a sweep writes no recordings
+    let plain = out(&dir, "plain");
+    magsep(&["sweep", &sweep, "--out", &plain, "--quiet"]);
+    assert!(Path::new(&plain).join("points/0/summary.json").is_file());
+    assert!(!Path::new(&plain).join("points/0/recording.mcap").exists());
 }
