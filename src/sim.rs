@@ -157,14 +157,6 @@ impl Simulation {
             app.add_boxed_plugin(p.clone());
         }
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
-        if !scene.packed_columns.is_empty() {
-            let columns = Value::Array(scene.packed_columns.clone());
-            app.world.insert_resource(PackedColumns(columns));
-            app.world
-                .get_resource_or_insert_with(SummaryExtras::default)
-                .0
-                .push(("fibre_packings".into(), packed_columns));
-        }
         if let Some(path) = &options.record {
             let writer = open_recording(&mut app, path, scene, pipeline.as_ref(), seed)?;
             let every = app
@@ -326,15 +318,6 @@ pub fn partial(error: SimError, mut summary: Value) -> SimError {
 
 /// A function giving one summary key from the final world (`None`: leave the key out).
 pub type SummaryFn = fn(&World) -> Option<Value>;
-
-/// The `[[fibre_packings]]` columns packed when the scene was read (a resource).
-#[derive(Resource)]
-struct PackedColumns(Value);
-
-/// The summary's `fibre_packings`.
-fn packed_columns(world: &World) -> Option<Value> {
-    world.get_resource::<PackedColumns>().map(|p| p.0.clone())
-}
 
 /// Keys plugins add to the run's summary: (key, function of the final world) (a resource).
 #[derive(Resource, Default, Clone)]
