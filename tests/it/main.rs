@@ -30,4 +30,5 @@ mod schedule;
 mod signals;
 mod spheroid_collisions;
 mod spheroids;
+mod sweep_curves;
 mod sweeps;

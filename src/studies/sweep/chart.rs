@@ -27,14 +27,14 @@ pub fn mean_ci95(ys: &[f64]) -> (f64, f64) {
 }
 
 /// A file-name-safe form of `s`.
-fn slug(s: &str) -> String {
+pub(super) fn slug(s: &str) -> String {
     s.chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
         .collect()
 }
 
 /// The axis label: name and unit.
-fn label(name: &str, unit: Option<&str>) -> String {
+pub(super) fn label(name: &str, unit: Option<&str>) -> String {
     match unit {
         Some(u) => format!("{name} [{u}]"),
         None => name.to_string(),
@@ -111,7 +111,7 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
 }
 
 /// Whether axis `k` is the first of its zipped group (or in none).
-fn leads(sweep: &Sweep, k: usize) -> bool {
+pub(super) fn leads(sweep: &Sweep, k: usize) -> bool {
     (sweep.groups.iter())
         .find(|g| g.contains(&k))
         .is_none_or(|g| g.first() == Some(&k))

@@ -53,6 +53,31 @@ struct SweepSpec {
     seed_key: Option<String>,
     #[serde(default)]
     collect: Vec<String>,
+    #[serde(default)]
+    curves: Vec<CurveSpec>,
+}
+
+/// `[[curves]]`: a pair of summary arrays, averaged over replicates point by point.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CurveSpec {
+    x: String,
+    y: String,
+    name: Option<String>,
+    x_unit: Option<String>,
+}
+
+/// A curve collected from every point's summary: `y` against `x`, both arrays of numbers.
+#[derive(Debug, Clone)]
+pub struct Curve {
+    /// File name stem and chart title (`name`, default the `y` path).
+    pub name: String,
+    /// Summary path of the x array (as written, path).
+    pub x: (String, KeyPath),
+    /// Summary path of the y array (as written, path).
+    pub y: (String, KeyPath),
+    /// Unit of x for the chart label.
+    pub x_unit: Option<String>,
 }
 
 /// One axis: the override path and its values.
@@ -104,6 +129,8 @@ pub struct Sweep {
     pub scene_seed: Option<u64>,
     /// Collected summary values: (as written, path).
     pub collect: Vec<(String, KeyPath)>,
+    /// Collected curves (`[[curves]]`).
+    pub curves: Vec<Curve>,
 }
 
 fn err(path: impl Into<String>, msg: impl Into<String>) -> SceneError {
@@ -222,7 +249,8 @@ fn edit_value(v: &toml::Value) -> Option<Value> {
         .ok()?
         .parse::<toml_edit::DocumentMut>()
         .ok()?;
-    doc.get("v")?.as_value().cloned()
+    // a table value serialises as a `[v]` section: back to an inline table
+    doc.get("v")?.clone().into_value().ok()
 }
 
 fn axis(spec: &AxisSpec, k: usize, errors: &mut Vec<SceneError>) -> Option<Axis> {
@@ -247,7 +275,18 @@ fn axis(spec: &AxisSpec, k: usize, errors: &mut Vec<SceneError>) -> Option<Axis>
         if v.is_empty() {
             errors.push(err(format!("{at}.values"), "must not be empty"));
         }
-        v.iter().filter_map(edit_value).collect()
+        (v.iter().enumerate())
+            .filter_map(|(j, x)| {
+                let e = edit_value(x);
+                if e.is_none() {
+                    errors.push(err(
+                        format!("{at}.values[{j}]"),
+                        "not a value a scene can hold",
+                    ));
+                }
+                e
+            })
+            .collect()
     } else if let Some(r) = &spec.range {
         range_values(r, &format!("{at}.range"), errors)
     } else if let Some(s) = &spec.linspace {
@@ -378,6 +417,26 @@ impl Sweep {
                 }
             })
             .collect();
+        let mut curves = Vec::new();
+        for (k, c) in spec.curves.iter().enumerate() {
+            let x = KeyPath::parse(&c.x).map_err(|e| errors.push(err(format!("curves[{k}].x"), e)));
+            let y = KeyPath::parse(&c.y).map_err(|e| errors.push(err(format!("curves[{k}].y"), e)));
+            let name = c.name.clone().unwrap_or_else(|| c.y.clone());
+            if curves.iter().any(|d: &Curve| d.name == name) {
+                errors.push(err(
+                    format!("curves[{k}].name"),
+                    format!("`{name}` names two curves (give each a distinct name)"),
+                ));
+            }
+            if let (Ok(x), Ok(y)) = (x, y) {
+                curves.push(Curve {
+                    name,
+                    x: (c.x.clone(), x),
+                    y: (c.y.clone(), y),
+                    x_unit: c.x_unit.clone(),
+                });
+            }
+        }
         let doc = parse_document(&scene_text).map_err(|e| {
             SceneErrors(
                 e.0.into_iter()
@@ -420,6 +479,7 @@ impl Sweep {
             seed,
             scene_seed,
             collect,
+            curves,
         })
     }
 

@@ -10,6 +10,7 @@
 //! `recording.mcap` with `--record`), `results.csv` and `charts/*.svg`.
 
 pub mod chart;
+pub mod curves;
 pub mod file;
 pub mod run;
 pub mod slurm;
@@ -197,6 +198,7 @@ pub fn finish(sweep: &Sweep, out: &Path) -> Result<Value, SweepError> {
     write_atomic(&results, &csv).map_err(SweepError::Runtime)?;
     let charts =
         chart::write_charts(sweep, &rows, &out.join("charts")).map_err(SweepError::Runtime)?;
+    let (curve_files, left_out) = curves::write_curves(sweep, out).map_err(SweepError::Runtime)?;
     let (ok, error, missing) = table::counts(&rows);
     let absent: serde_json::Map<String, Value> = table::absent_values(sweep, &rows)
         .into_iter()
@@ -209,6 +211,11 @@ pub fn finish(sweep: &Sweep, out: &Path) -> Result<Value, SweepError> {
         "failed": error,
         "missing": missing,
         "collected_values_absent": absent,
+        "curves": curve_files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+        "curve_points_left_out": left_out
+            .into_iter()
+            .map(|(k, n)| (k, json!(n)))
+            .collect::<serde_json::Map<String, Value>>(),
     }))
 }
 
