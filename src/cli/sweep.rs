@@ -37,6 +37,11 @@ pub struct SweepCommand {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Memory budget [GiB] of the points running at once (default: 16 GiB or 3/4 of the
+    /// machine's memory, whichever is smaller; or MAGSEP_MEMORY_BUDGET): fewer points run at
+    /// once when their estimates exceed it, and a point that alone exceeds it is an error
+    #[arg(long, value_name = "GiB")]
+    memory_budget: Option<f64>,
 }
 
 #[derive(Subcommand)]
@@ -158,6 +163,8 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 record: cmd.record,
                 shard,
                 retry_failed: cmd.retry_failed,
+                memory_budget: crate::scene::memory::budget(cmd.memory_budget)
+                    .map_err(CliError::input)?,
             };
             let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), &bar)
                 .map_err(to_cli)?;

@@ -31,4 +31,5 @@ mod signals;
 mod spheroid_collisions;
 mod spheroids;
 mod sweep_curves;
+mod sweep_memory;
 mod sweeps;

@@ -53,6 +53,8 @@ pub struct SweepRun {
     pub shard: Option<(usize, usize)>,
     /// Run failed points again (a finished point is otherwise never redone).
     pub retry_failed: bool,
+    /// Memory budget \[bytes\] of the points running at once.
+    pub memory_budget: u64,
 }
 
 /// Load and validate `path` (the sweep file): bad input at its key path.
@@ -147,6 +149,15 @@ pub fn run_sweep(
             _ => false,
         })
         .collect();
+    let (jobs, largest) =
+        run::jobs_within_budget(&sweep, registry, &todo, args.jobs, args.memory_budget).map_err(
+            |e| {
+                SweepError::Input(format!(
+                    "{}: a point's scene needs more memory than the budget:\n{e}",
+                    args.sweep.display()
+                ))
+            },
+        )?;
     bar.set_length(mine.len() as u64);
     bar.set_position((mine.len() - todo.len()) as u64);
     let runner = Runner {
@@ -157,7 +168,7 @@ pub fn run_sweep(
         record: args.record,
     };
     let failed = runner
-        .run_all(&todo, args.jobs, &|| bar.inc(1))
+        .run_all(&todo, jobs, &|| bar.inc(1))
         .map_err(SweepError::Runtime)?;
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
@@ -170,6 +181,10 @@ pub fn run_sweep(
         "ran": todo.len(),
         "skipped": mine.len() - todo.len(),
         "failed_now": failed,
+        "jobs": jobs,
+        "jobs_limited_by_memory": jobs < args.jobs.min(todo.len()),
+        "largest_point_memory_estimate_bytes": largest.round() as u64,
+        "memory_budget_bytes": args.memory_budget,
         "wall_time_s": seconds,
         "points_per_second": todo.len() as f64 / seconds.max(1e-9),
     });

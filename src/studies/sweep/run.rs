@@ -106,6 +106,50 @@ pub fn check_points(sweep: &Sweep, registry: &Registry, indices: &[usize]) -> Re
     Err(format!("{}{more}", failing.join("\n")))
 }
 
+/// How many of `jobs` points may run at once within `budget` \[bytes\]: each point of
+/// `indices` must fit alone (else an error naming the point and the key that drives its
+/// estimate), and the `J` largest estimates together, so `J` is lowered until they do.
+/// Returns `J` (at least 1) and the largest estimate \[bytes\].
+///
+/// # Errors
+/// The points over the budget (up to ten listed).
+pub fn jobs_within_budget(
+    sweep: &Sweep,
+    registry: &Registry,
+    indices: &[usize],
+    jobs: usize,
+    budget: u64,
+) -> Result<(usize, f64), String> {
+    let base = base_document(sweep).map_err(|e| format!("scene: {e}"))?;
+    let mut estimates = Vec::with_capacity(indices.len());
+    let mut failing = Vec::new();
+    for &i in indices {
+        let point = sweep.point(i);
+        let Ok(scene) = point_scene(sweep, &base, &point, registry) else {
+            continue; // reported by check_points
+        };
+        match crate::scene::memory::check(&scene, budget) {
+            Ok(e) => estimates.push(e.bytes),
+            Err(e) if failing.len() < MAX_LISTED => {
+                let ovs: Vec<String> = (sweep.overrides(&point).iter())
+                    .map(ToString::to_string)
+                    .collect();
+                failing.push(format!("point {i} ({}):\n{e}", ovs.join(" ")));
+            }
+            Err(_) => {}
+        }
+    }
+    if !failing.is_empty() {
+        return Err(failing.join("\n"));
+    }
+    estimates.sort_by(|a, b| b.total_cmp(a));
+    let mut j = jobs.clamp(1, estimates.len().max(1));
+    while j > 1 && estimates[..j].iter().sum::<f64>() > budget as f64 {
+        j -= 1;
+    }
+    Ok((j, estimates.first().copied().unwrap_or(0.0)))
+}
+
 /// The manifest of a sweep directory: what identifies the sweep.
 pub fn manifest(sweep: &Sweep) -> Value {
     json!({
