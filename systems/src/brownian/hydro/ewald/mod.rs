@@ -52,6 +52,7 @@
 //! SI: positions, radii \[m\], viscosity [Pa s], forces \[N\], velocities [m/s]. Unbounded
 //! fluid, translational RPY (as the dense methods).
 
+pub(crate) mod direct;
 pub(crate) mod fft3;
 pub(crate) mod kernels;
 pub(crate) mod near;
@@ -61,6 +62,7 @@ pub(crate) mod wave;
 use glam::DVec3;
 
 use super::HydroError;
+use direct::Direct;
 use near::Near;
 use params::Params;
 use wave::Wave;
@@ -72,8 +74,15 @@ const PRODUCTS_PER_STEP: f64 = 12.0;
 #[derive(Debug)]
 pub(crate) struct SpectralEwald {
     params: Params,
-    near: Near,
+    real: Real,
     wave: Option<Wave>,
+}
+
+/// The pair part: a stored cut-off list with the grid, or the streamed direct sum.
+#[derive(Debug)]
+enum Real {
+    Near(Near),
+    Direct(Direct),
 }
 
 impl SpectralEwald {
@@ -110,7 +119,11 @@ impl SpectralEwald {
     }
 
     fn with_params(params: Params, positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
-        let near = Near::new(&params, positions, radii, viscosity);
+        let real = if params.is_direct() {
+            Real::Direct(Direct::new(positions, radii, viscosity))
+        } else {
+            Real::Near(Near::new(&params, positions, radii, viscosity))
+        };
         let wave = (!params.is_direct() && !positions.is_empty()).then(|| {
             Wave::new(
                 &params,
@@ -119,12 +132,15 @@ impl SpectralEwald {
                 1.0 / (8.0 * std::f64::consts::PI * viscosity),
             )
         });
-        Self { params, near, wave }
+        Self { params, real, wave }
     }
 
     /// out = μ x for flat 3N vectors.
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
-        self.near.apply(x, out);
+        match &self.real {
+            Real::Near(near) => near.apply(x, out),
+            Real::Direct(direct) => direct.apply(x, out),
+        }
         if let Some(w) = &self.wave {
             w.apply_add(x, out);
         }
@@ -138,7 +154,10 @@ impl SpectralEwald {
             cutoff: self.params.cutoff,
             grid: self.params.fft_n,
             support: self.params.support,
-            pair_blocks: self.near.pairs(),
+            pair_blocks: match &self.real {
+                Real::Near(near) => near.pairs(),
+                Real::Direct(direct) => direct.pairs(),
+            },
         }
     }
 }
@@ -154,7 +173,8 @@ pub struct EwaldSummary {
     pub grid: usize,
     /// Gaussian support P (points per side)
     pub support: usize,
-    /// stored real-space pair blocks (each pair twice)
+    /// stored real-space pair blocks (each pair twice; for the direct sum only the
+    /// overlapping pairs, the others are evaluated on the fly)
     pub pair_blocks: usize,
 }
 
