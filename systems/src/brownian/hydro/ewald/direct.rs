@@ -4,7 +4,7 @@
 //! compact systems, e.g. N = 1000 at φ = 0.01). Each product evaluates every far pair block
 //! (Zuk et al. 2014, r > a_i + a_j)
 //! μ_ij = (1/8πηr)[(1 + q/3) I + (1 − q) r̂r̂], q = (a_i² + a_j²)/r²,
-//! on the fly from structure-of-arrays positions, in four independent lanes per row that the
+//! on the fly from structure-of-arrays positions, in eight independent lanes per row that the
 //! compiler vectorises (SSE2; AVX2 when the processor has it: the same operations, no fused
 //! multiply-add, so bitwise the same result). Overlapping pairs (r ≤ a_i + a_j, found once
 //! per configuration with a cell list) are masked out of the lanes and added from a short list
@@ -13,7 +13,7 @@
 //! Preparation is O(N) plus the overlap search; each product is O(N²) flops with O(N) memory
 //! (the stored alternative, [`super::near::Near`] with ξ = 0, keeps 40 bytes per pair and
 //! spends most of its time building them). Rows are independent and each is summed in a
-//! fixed order (lane l takes j ≡ l mod 4, lanes combined in order, then the tail, then the
+//! fixed order (lane l takes j ≡ l mod 8, lanes combined pairwise in a fixed tree, then the
 //! overlap blocks), so the result is bitwise the same for every thread count.
 //!
 //! Units: positions and radii \[m\], viscosity [Pa s], forces \[N\], velocities [m/s].
@@ -29,7 +29,7 @@ use crate::brownian::hydro::rpy::{rpy_coefficients, self_mobility};
 const ROWS: usize = 16;
 
 /// Lanes per row (independent partial sums).
-const LANES: usize = 4;
+const LANES: usize = 8;
 
 /// The prepared streamed direct product of one configuration.
 #[derive(Debug)]
@@ -117,7 +117,7 @@ fn row_sum(s: &Src<'_>, p: [f64; 3], a: f64, a2: f64) -> [f64; 3] {
     for j0 in (0..s.x.len()).step_by(LANES) {
         add_lanes(s, j0, p, a, a2, &mut acc);
     }
-    acc.map(|v| (v[0] + v[1]) + (v[2] + v[3]))
+    acc.map(|v| ((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7])))
 }
 
 /// [`row_sum`] compiled for AVX2 (same operations, wider vectors).
