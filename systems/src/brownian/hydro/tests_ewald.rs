@@ -444,3 +444,20 @@ fn direct_product_timing() {
         ts[2] / td[2]
     );
 }
+
+#[test]
+#[ignore = "profile probe (callgrind): N = 10^4 spectral Ewald, prepare + 2 products"]
+fn ewald_product_profile() {
+    let (n, a) = (10_000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let f = flat(&normals(&mut rng, n));
+    let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    let mut v = vec![0.0; 3 * n];
+    for _ in 0..2 {
+        op.apply(&f, &mut v);
+    }
+    eprintln!("{:?} {}", op.summary(), v[0]);
+}
