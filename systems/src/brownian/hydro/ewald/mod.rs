@@ -42,7 +42,9 @@
 //! and n ≈ 2 D/h + 2P grid points per side (D the configuration's extent); the cut-off is
 //! chosen by a cost model ([`params`]), so for dilute systems the grid grows with the volume,
 //! not with N. Preparation (pair blocks and the kernel's transform) is done once per
-//! configuration.
+//! configuration. When the cost model picks the direct sum (small or compact systems, e.g.
+//! N = 1000 at φ = 0.01) nothing is stored: every product streams all pairs (`direct`,
+//! vectorised, O(N²) flops, O(N) memory).
 //!
 //! # Determinism
 //! Every stage is parallel over independent rows, grid planes or FFT lines, each summed in a

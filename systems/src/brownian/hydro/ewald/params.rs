@@ -20,7 +20,7 @@
 //! on the development machine) over a geometric ladder of cut-offs; when the direct sum (ξ = 0,
 //! no grid, all pairs) is cheaper it is used. Grids above [`MAX_FFT`] per side and pair lists
 //! above [`MAX_PAIR_BLOCKS`] are never chosen (an error instead of running out of memory); the
-//! direct sum, streamed without storage ([`super::direct`]), is bounded by the same number of
+//! direct sum, streamed without storage (module `direct`), is bounded by the same number of
 //! pairs (a time limit: N ≤ 7071).
 
 use glam::DVec3;
