@@ -96,6 +96,31 @@ fn streamed_direct_product_matches_dense_rpy() {
 }
 
 #[test]
+fn streamed_direct_noise_covariance_at_the_benchmark_tolerances() {
+    // the step_timing settings (product 1e-4, Krylov 1e-3) at φ ≈ 0.01, polydisperse: the
+    // cost model picks the streamed direct sum; its Lanczos covariance against the dense
+    // Cholesky one (exact to rounding)
+    let n = 120;
+    let edge = A * (n as f64 * 4.19 / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
+    let (pos, radii) = random_config(&mut rng, n, edge, true);
+    let exact = rpy_matrix(&pos, &radii, ETA);
+    let opts = MobilityOptions {
+        krylov_tolerance: 1e-3,
+        ewald_tolerance: 1e-4,
+        ..MobilityOptions::default()
+    };
+    let mob = Mobility::new_with(MobilityMethod::SpectralEwald, &pos, &radii, ETA, opts).unwrap();
+    assert_eq!(mob.ewald_summary().unwrap().grid, 0, "direct sum expected");
+    let chol = Mobility::new_with(MobilityMethod::Cholesky, &pos, &radii, ETA, opts).unwrap();
+    let e_chol = covariance_error(&chol, &exact).unwrap();
+    let e = covariance_error(&mob, &exact).unwrap();
+    eprintln!("covariance error: streamed direct + Lanczos {e:e}, Cholesky {e_chol:e}");
+    assert!(e_chol < 1e-12, "{e_chol}");
+    assert!(e < 2e-3, "{e}");
+}
+
+#[test]
 fn kernel_split_adds_up_to_the_exact_kernels() {
     let xi = 2.0e6;
     for r in [1e-8, 1e-7, 3e-7, 1e-6, 2e-6] {
