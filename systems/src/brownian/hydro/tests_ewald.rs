@@ -67,6 +67,60 @@ fn apply(op: &SpectralEwald, f: &[f64]) -> Vec<f64> {
 }
 
 #[test]
+fn streamed_direct_product_matches_dense_rpy() {
+    use super::ewald::direct::Direct;
+    // polydisperse, with overlaps, coincident centres and N not a multiple of the lane count
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
+    for (n, edge) in [(1, 4.0), (2, 4.0), (7, 4.0), (203, 12.0), (402, 40.0)] {
+        let (mut pos, radii) = random_config(&mut rng, n, edge * A, true);
+        if n > 3 {
+            pos[3] = pos[1];
+        }
+        let f = flat(&normals(&mut rng, n));
+        let exact = dense_product(&pos, &radii, &f);
+        let op = Direct::new(&pos, &radii, ETA);
+        let mut v = vec![0.0; f.len()];
+        op.apply_with(&f, &mut v, false);
+        let e = rel_err(&v, &exact);
+        assert!(e < 1e-13, "N = {n}: error {e}");
+        if n > 100 {
+            assert!(op.pairs() > 0, "N = {n}: no overlaps tested");
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let mut w = vec![0.0; f.len()];
+            op.apply_with(&f, &mut w, true);
+            assert_eq!(v, w, "AVX2 and SSE2 paths differ");
+        }
+    }
+}
+
+#[test]
+fn streamed_direct_noise_covariance_at_the_benchmark_tolerances() {
+    // the step_timing settings (product 1e-4, Krylov 1e-3) at φ ≈ 0.01, polydisperse: the
+    // cost model picks the streamed direct sum; its Lanczos covariance against the dense
+    // Cholesky one (exact to rounding)
+    let n = 120;
+    let edge = A * (n as f64 * 4.19 / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
+    let (pos, radii) = random_config(&mut rng, n, edge, true);
+    let exact = rpy_matrix(&pos, &radii, ETA);
+    let opts = MobilityOptions {
+        krylov_tolerance: 1e-3,
+        ewald_tolerance: 1e-4,
+        ..MobilityOptions::default()
+    };
+    let mob = Mobility::new_with(MobilityMethod::SpectralEwald, &pos, &radii, ETA, opts).unwrap();
+    assert_eq!(mob.ewald_summary().unwrap().grid, 0, "direct sum expected");
+    let chol = Mobility::new_with(MobilityMethod::Cholesky, &pos, &radii, ETA, opts).unwrap();
+    let e_chol = covariance_error(&chol, &exact).unwrap();
+    let e = covariance_error(&mob, &exact).unwrap();
+    eprintln!("covariance error: streamed direct + Lanczos {e:e}, Cholesky {e_chol:e}");
+    assert!(e_chol < 1e-12, "{e_chol}");
+    assert!(e < 2e-3, "{e}");
+}
+
+#[test]
 fn kernel_split_adds_up_to_the_exact_kernels() {
     let xi = 2.0e6;
     for r in [1e-8, 1e-7, 3e-7, 1e-6, 2e-6] {
@@ -371,4 +425,64 @@ fn step_timing() {
             });
         }
     }
+}
+
+#[test]
+#[ignore = "timing probe: cargo test --release -p magsep-systems --lib direct_product_timing -- --ignored --nocapture"]
+fn direct_product_timing() {
+    use super::ewald::direct::Direct;
+    use super::ewald::near::Near;
+    use super::ewald::params::Params;
+    use std::time::Instant;
+    // N = 1000 at φ = 0.01: stored pair blocks (Near with ξ = 0) against the streamed product,
+    // each prepared once and applied 14 times (one step), interleaved 5 times
+    let (n, a) = (1000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let f = flat(&normals(&mut rng, n));
+    let params = Params::with_cutoff(1e-4, None, &pos, &radii);
+    let mut v = vec![0.0; 3 * n];
+    let (mut ts, mut td) = (Vec::new(), Vec::new());
+    for _ in 0..5 {
+        let t = Instant::now();
+        let near = Near::new(&params, &pos, &radii, ETA);
+        for _ in 0..14 {
+            near.apply(&f, &mut v);
+        }
+        ts.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let direct = Direct::new(&pos, &radii, ETA);
+        for _ in 0..14 {
+            direct.apply(&f, &mut v);
+        }
+        td.push(t.elapsed().as_secs_f64());
+    }
+    ts.sort_by(f64::total_cmp);
+    td.sort_by(f64::total_cmp);
+    eprintln!(
+        "N {n}, 14 products, threads {}: stored {:.4} s, streamed {:.4} s (medians), ratio {:.2}",
+        rayon::current_num_threads(),
+        ts[2],
+        td[2],
+        ts[2] / td[2]
+    );
+}
+
+#[test]
+#[ignore = "profile probe (callgrind): N = 10^4 spectral Ewald, prepare + 2 products"]
+fn ewald_product_profile() {
+    let (n, a) = (10_000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let f = flat(&normals(&mut rng, n));
+    let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    let mut v = vec![0.0; 3 * n];
+    for _ in 0..2 {
+        op.apply(&f, &mut v);
+    }
+    eprintln!("{:?} {}", op.summary(), v[0]);
 }

@@ -42,7 +42,9 @@
 //! and n ≈ 2 D/h + 2P grid points per side (D the configuration's extent); the cut-off is
 //! chosen by a cost model ([`params`]), so for dilute systems the grid grows with the volume,
 //! not with N. Preparation (pair blocks and the kernel's transform) is done once per
-//! configuration.
+//! configuration. When the cost model picks the direct sum (small or compact systems, e.g.
+//! N = 1000 at φ = 0.01) nothing is stored: every product streams all pairs (`direct`,
+//! vectorised, O(N²) flops, O(N) memory).
 //!
 //! # Determinism
 //! Every stage is parallel over independent rows, grid planes or FFT lines, each summed in a
@@ -52,6 +54,7 @@
 //! SI: positions, radii \[m\], viscosity [Pa s], forces \[N\], velocities [m/s]. Unbounded
 //! fluid, translational RPY (as the dense methods).
 
+pub(crate) mod direct;
 pub(crate) mod fft3;
 pub(crate) mod kernels;
 pub(crate) mod near;
@@ -61,6 +64,7 @@ pub(crate) mod wave;
 use glam::DVec3;
 
 use super::HydroError;
+use direct::Direct;
 use near::Near;
 use params::Params;
 use wave::Wave;
@@ -72,8 +76,15 @@ const PRODUCTS_PER_STEP: f64 = 12.0;
 #[derive(Debug)]
 pub(crate) struct SpectralEwald {
     params: Params,
-    near: Near,
+    real: Real,
     wave: Option<Wave>,
+}
+
+/// The pair part: a stored cut-off list with the grid, or the streamed direct sum.
+#[derive(Debug)]
+enum Real {
+    Near(Near),
+    Direct(Direct),
 }
 
 impl SpectralEwald {
@@ -110,7 +121,11 @@ impl SpectralEwald {
     }
 
     fn with_params(params: Params, positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
-        let near = Near::new(&params, positions, radii, viscosity);
+        let real = if params.is_direct() {
+            Real::Direct(Direct::new(positions, radii, viscosity))
+        } else {
+            Real::Near(Near::new(&params, positions, radii, viscosity))
+        };
         let wave = (!params.is_direct() && !positions.is_empty()).then(|| {
             Wave::new(
                 &params,
@@ -119,12 +134,15 @@ impl SpectralEwald {
                 1.0 / (8.0 * std::f64::consts::PI * viscosity),
             )
         });
-        Self { params, near, wave }
+        Self { params, real, wave }
     }
 
     /// out = μ x for flat 3N vectors.
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
-        self.near.apply(x, out);
+        match &self.real {
+            Real::Near(near) => near.apply(x, out),
+            Real::Direct(direct) => direct.apply(x, out),
+        }
         if let Some(w) = &self.wave {
             w.apply_add(x, out);
         }
@@ -138,7 +156,10 @@ impl SpectralEwald {
             cutoff: self.params.cutoff,
             grid: self.params.fft_n,
             support: self.params.support,
-            pair_blocks: self.near.pairs(),
+            pair_blocks: match &self.real {
+                Real::Near(near) => near.pairs(),
+                Real::Direct(direct) => direct.pairs(),
+            },
         }
     }
 }
@@ -154,7 +175,8 @@ pub struct EwaldSummary {
     pub grid: usize,
     /// Gaussian support P (points per side)
     pub support: usize,
-    /// stored real-space pair blocks (each pair twice)
+    /// stored real-space pair blocks (each pair twice; for the direct sum only the
+    /// overlapping pairs, the others are evaluated on the fly)
     pub pair_blocks: usize,
 }
 

@@ -19,7 +19,9 @@
 //! chosen by minimising a cost model (nanoseconds per pair and per grid point log n, estimated
 //! on the development machine) over a geometric ladder of cut-offs; when the direct sum (ξ = 0,
 //! no grid, all pairs) is cheaper it is used. Grids above [`MAX_FFT`] per side and pair lists
-//! above [`MAX_PAIR_BLOCKS`] are never chosen (an error instead of running out of memory).
+//! above [`MAX_PAIR_BLOCKS`] are never chosen (an error instead of running out of memory); the
+//! direct sum, streamed without storage (module `direct`), is bounded by the same number of
+//! pairs (a time limit: N ≤ 7071).
 
 use glam::DVec3;
 
@@ -176,13 +178,16 @@ impl Params {
             (hi - lo).max(DVec3::splat(2.0 * a_max)).element_product()
         };
         let density = n / volume;
-        // nanoseconds (2-core development machine): pair set-up with erfc/exp, without (direct
-        // sum), pair product, FFT per point·log2(points) and field, spreading+gathering per
-        // particle, support point and field. The kernel's transform is cached across steps.
-        let (pair_setup, direct_setup, pair_apply, fft_unit, spread) = (150.0, 40.0, 8.0, 1.0, 1.0);
+        // nanoseconds (2-core development machine): pair set-up with erfc/exp, stored pair
+        // product, streamed direct pair (evaluated in every product, nothing stored: 5.6×
+        // cheaper than the stored direct pairs' 40 ns set-up + 14 products at 8 ns, measured
+        // by `direct_product_timing`), FFT per point·log2(points) and field,
+        // spreading+gathering per particle, support point and field. The kernel's transform
+        // is cached across steps.
+        let (pair_setup, pair_apply, direct_pair, fft_unit, spread) = (150.0, 8.0, 1.9, 1.0, 1.0);
         let cost_of = |p: &Params| -> f64 {
             if p.is_direct() {
-                return n * n * (direct_setup + products * pair_apply);
+                return n * n * products * direct_pair;
             }
             let pairs =
                 (n * density * 4.0 / 3.0 * std::f64::consts::PI * p.cutoff.powi(3)).min(n * n);
@@ -193,14 +198,12 @@ impl Params {
             pairs * pair_setup + products * per
         };
         let pairs_of = |p: &Params| {
-            if p.is_direct() {
-                n * n
-            } else {
-                (n * density * 4.0 / 3.0 * std::f64::consts::PI * p.cutoff.powi(3)).min(n * n)
-            }
+            (n * density * 4.0 / 3.0 * std::f64::consts::PI * p.cutoff.powi(3)).min(n * n)
         };
+        // the streamed direct sum stores nothing, but its pairs are bounded like a stored
+        // list's (above 5e7 pairs one product takes ~0.1 s and a grid is always cheaper)
         let direct = Self::with_cutoff(tolerance, None, positions, radii);
-        let mut best = direct.fits(pairs_of(&direct)).then_some(direct);
+        let mut best = (n * n <= MAX_PAIR_BLOCKS).then_some(direct);
         let mut best_cost = best.as_ref().map_or(f64::INFINITY, &cost_of);
         // the ladder starts at 2 max(a)·1.25² (smaller cut-offs need very fine grids)
         let mut rc = 2.0 * a_max * 1.25 * 1.25;
