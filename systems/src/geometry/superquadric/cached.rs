@@ -1,8 +1,8 @@
-//! The contact of [`super::contact`] for shapes whose constants are computed once
+//! The contact of [`super::contact()`] for shapes whose constants are computed once
 //! ([`PreparedShape`]): a packing evaluates millions of contacts between a handful of shapes,
 //! and the per-call constants (validity, the powers of the support map and inside function,
 //! the bounding radii with their `powf`) cost about a tenth of a warm-started call. The
-//! answer is bit for bit that of [`super::contact`] (tested on random poses in
+//! answer is bit for bit that of [`super::contact()`] (tested on random poses in
 //! `tests_cached.rs`): only where the constants come from differs.
 
 use glam::{DQuat, DVec3};
@@ -54,7 +54,7 @@ impl PreparedShape {
     }
 }
 
-/// [`super::contact`] of two prepared shapes: the same answer, bit for bit.
+/// [`super::contact()`] of two prepared shapes: the same answer, bit for bit.
 ///
 /// ```
 /// use glam::{DQuat, DVec3};
