@@ -8,7 +8,10 @@
 //! Every point is the mean of independent runs (seeds 1..=runs) with a Student-t 95 % interval.
 //! Periodic reference runs of the same shapes give phi_periodic and \<C\>_periodic for the
 //! rescaled measures phi* and \<C\>* ([T000 §2.4]). Runs go in parallel over rayon;
-//! each run is single-threaded and deterministic.
+//! each run is single-threaded and deterministic. The wedge sweep hands every run of every
+//! point to rayon in one pass ([`points`], largest packings first), so no core idles while a
+//! point's slowest run finishes and more than `runs` cores are used; the results are those
+//! of the points computed one by one (tested).
 
 mod sweeps;
 
@@ -148,6 +151,47 @@ pub fn particles_for(container: &ContainerSpec, shape: Shape, n: usize) -> usize
     n.max(needed).min(MAX_PARTICLES)
 }
 
+/// One configuration of a sweep: the arguments of [`point_with`].
+#[derive(Debug, Clone)]
+pub struct PointSpec {
+    /// What was varied, for the summary.
+    pub label: String,
+    /// Particles (raised by [`particles_for`]).
+    pub n: usize,
+    /// Particle shape (D = 1 units).
+    pub shape: Shape,
+    /// Container.
+    pub container: ContainerSpec,
+    /// Initial packing fraction.
+    pub phi0: f64,
+    /// Runs (seeds 1..=runs).
+    pub runs: u64,
+    /// Overlap-removal scheme.
+    pub scheme: OverlapRemovalScheme,
+}
+
+impl PointSpec {
+    /// A FIRE configuration (what [`point`] runs).
+    pub fn fire(
+        label: String,
+        n: usize,
+        shape: Shape,
+        container: ContainerSpec,
+        phi0: f64,
+        runs: u64,
+    ) -> Self {
+        Self {
+            label,
+            n,
+            shape,
+            container,
+            phi0,
+            runs,
+            scheme: OverlapRemovalScheme::Fire,
+        }
+    }
+}
+
 /// [`point`] with the overlap-removal `scheme`.
 pub fn point_with(
     label: String,
@@ -158,12 +202,65 @@ pub fn point_with(
     runs: u64,
     scheme: OverlapRemovalScheme,
 ) -> Result<Point, BenchError> {
-    let n = particles_for(container, shape, n);
-    let label = format!("{label} (N = {n})");
-    let results: Vec<RunMeasures> = (1..=runs)
-        .into_par_iter()
-        .map(|seed| measure(n, shape, container, phi0, seed, scheme))
+    let spec = PointSpec {
+        label,
+        n,
+        shape,
+        container: container.clone(),
+        phi0,
+        runs,
+        scheme,
+    };
+    let mut p = points(std::slice::from_ref(&spec))?;
+    p.pop()
+        .ok_or_else(|| BenchError::Runtime("no point computed".into()))
+}
+
+/// The points of `specs`, with the runs of all points in one parallel pass: a thread that
+/// finishes a run takes the next one of any point (the largest packings first), so no core
+/// waits for the slowest run of a point, and up to (points x runs) cores are used instead of
+/// `runs`. Each run is single-threaded and deterministic, so every point is the one
+/// [`point_with`] computes alone (tested).
+pub fn points(specs: &[PointSpec]) -> Result<Vec<Point>, BenchError> {
+    let sizes: Vec<usize> = specs
+        .iter()
+        .map(|s| particles_for(&s.container, s.shape, s.n))
+        .collect();
+    let mut jobs: Vec<(usize, u64)> = specs
+        .iter()
+        .enumerate()
+        .flat_map(|(k, s)| (1..=s.runs).map(move |seed| (k, seed)))
+        .collect();
+    // longest first (cost grows with N): a long run started last would idle the other cores
+    jobs.sort_by_key(|&(k, seed)| (std::cmp::Reverse(sizes[k]), k, seed));
+    let done: Vec<RunMeasures> = jobs
+        .par_iter()
+        .with_max_len(1)
+        .map(|&(k, seed)| {
+            let s = &specs[k];
+            measure(sizes[k], s.shape, &s.container, s.phi0, seed, s.scheme)
+        })
         .collect::<Result<_, _>>()?;
+    let mut runs: Vec<Vec<(u64, RunMeasures)>> = vec![Vec::new(); specs.len()];
+    for (&(k, seed), r) in jobs.iter().zip(done) {
+        runs[k].push((seed, r));
+    }
+    Ok(specs
+        .iter()
+        .zip(sizes)
+        .zip(runs)
+        .map(|((s, n), mut r)| {
+            r.sort_by_key(|(seed, _)| *seed);
+            reduce(
+                format!("{} (N = {n})", s.label),
+                r.into_iter().map(|x| x.1).collect(),
+            )
+        })
+        .collect())
+}
+
+/// Runs of one configuration (in seed order) reduced to estimates.
+fn reduce(label: String, results: Vec<RunMeasures>) -> Point {
     let est = |f: fn(&RunMeasures) -> f64| {
         let v: Vec<f64> = results.iter().map(f).collect();
         mean_interval(&v)
@@ -177,7 +274,7 @@ pub fn point_with(
         est(|r| r.cubatic).mean,
         est(|r| r.wall_time_s).mean
     );
-    Ok(Point {
+    Point {
         label,
         phi: est(|r| r.phi),
         contacts: est(|r| r.contacts),
@@ -185,7 +282,7 @@ pub fn point_with(
         aligned: est(|r| r.aligned),
         cubatic: est(|r| r.cubatic),
         runs: results,
-    })
+    }
 }
 
 /// A spherocylinder of aspect ratio `lambda` with D = 1 (a sphere for 1).
@@ -204,4 +301,51 @@ pub fn rod(lambda: f64) -> Shape {
 pub fn half_width(e: &Estimate) -> f64 {
     let w = 0.5 * (e.hi - e.lo);
     if w.is_finite() { w } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The runs of several points in one parallel pass give each point exactly as computed
+    /// alone (the reference: [`measure`] seed by seed, serially).
+    #[test]
+    fn points_in_one_pass_equal_points_alone() {
+        let specs = [
+            PointSpec::fire(
+                "spheres".into(),
+                24,
+                rod(1.0),
+                ContainerSpec::PeriodicBox {},
+                0.05,
+                2,
+            ),
+            PointSpec::fire(
+                "rods".into(),
+                16,
+                rod(2.0),
+                ContainerSpec::PeriodicBox {},
+                0.05,
+                3,
+            ),
+        ];
+        let together = points(&specs).unwrap();
+        assert_eq!(together.len(), specs.len());
+        for (s, p) in specs.iter().zip(&together) {
+            assert_eq!(p.runs.len() as u64, s.runs);
+            for (seed, r) in (1..=s.runs).zip(&p.runs) {
+                let alone = measure(s.n, s.shape, &s.container, s.phi0, seed, s.scheme).unwrap();
+                assert_eq!(
+                    r.phi.to_bits(),
+                    alone.phi.to_bits(),
+                    "{} seed {seed}",
+                    s.label
+                );
+                assert_eq!(r.contacts.to_bits(), alone.contacts.to_bits());
+                assert_eq!(r.nematic.to_bits(), alone.nematic.to_bits());
+            }
+        }
+        // the seeds differ: the runs of a point are not copies
+        assert_ne!(together[0].runs[0].phi, together[0].runs[1].phi);
+    }
 }

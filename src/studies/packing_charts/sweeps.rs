@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde_json::json;
 
-use super::{Point, half_width, point, point_with, rod};
+use super::{Point, PointSpec, half_width, point, point_with, points, rod};
 use crate::chart::{Chart, Figure, Heatmap, Line, Series, Style, write_svg};
 use crate::pipelines::packing::ContainerSpec;
 use crate::studies::bench::BenchError;
@@ -199,17 +199,50 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
         .x_label("aspect ratio")
         .y_label("f_align");
     let mut summary = Vec::new();
-    let mut periodic = Vec::new();
-    for &l in &lambdas {
-        periodic.push(point(
-            format!("aspect {l} periodic"),
-            n,
-            rod(l),
-            &ContainerSpec::PeriodicBox {},
-            0.05,
-            runs,
-        )?);
+    // every run of the sweep (and the orientation map's) in one parallel pass
+    let mut specs: Vec<PointSpec> = lambdas
+        .iter()
+        .map(|&l| {
+            PointSpec::fire(
+                format!("aspect {l} periodic"),
+                n,
+                rod(l),
+                ContainerSpec::PeriodicBox {},
+                0.05,
+                runs,
+            )
+        })
+        .collect();
+    for &a in &angles {
+        for &l in &lambdas {
+            let lmin = wedge_min_length(0.5, l - 1.0, a * deg);
+            for &r in &ratios {
+                specs.push(PointSpec::fire(
+                    format!("alpha {a} aspect {l} l/lmin {r}"),
+                    n,
+                    rod(l),
+                    ContainerSpec::Wedge {
+                        angle: a * deg,
+                        length: r * lmin,
+                    },
+                    0.05,
+                    runs,
+                ));
+            }
+        }
     }
+    let map_ratio = *ratios.last().unwrap_or(&3.0);
+    let (computed, map_run) = rayon::join(
+        || points(&specs),
+        || orientation_run(n, angles[0] * deg, map_ratio),
+    );
+    let mut computed = computed?.into_iter();
+    let mut next = || {
+        computed
+            .next()
+            .ok_or_else(|| BenchError::Runtime("wedge sweep: a point is missing".into()))
+    };
+    let periodic: Vec<Point> = lambdas.iter().map(|_| next()).collect::<Result<_, _>>()?;
     for &a in &angles {
         let mut fa = Vec::new();
         for (k, &l) in lambdas.iter().enumerate() {
@@ -217,19 +250,7 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
             let phimin = wedge_min_packing_fraction(0.5, l - 1.0, a * deg);
             let mut pts = Vec::new();
             for &r in &ratios {
-                let spec = ContainerSpec::Wedge {
-                    angle: a * deg,
-                    length: r * lmin,
-                };
-                let p = point(
-                    format!("alpha {a} aspect {l} l/lmin {r}"),
-                    n,
-                    rod(l),
-                    &spec,
-                    0.05,
-                    runs,
-                )?;
-                pts.push((r, p));
+                pts.push((r, next()?));
             }
             if a == angles[0] {
                 let per = &periodic[k];
@@ -276,21 +297,19 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     .panel(align);
     let path = out.join("wedge_confinement.svg");
     save(&path, &fig.to_svg(520.0, 420.0))?;
-    let (hpath, histogram) =
-        orientation_map(out, n, angles[0] * deg, *ratios.last().unwrap_or(&3.0))?;
+    let (hpath, histogram) = orientation_map(out, angles[0] * deg, map_ratio, &map_run?)?;
     crate::studies::bench::say(
         json!({"charts": [path.display().to_string(), hpath.display().to_string()], "particles": n, "runs": runs, "sweeps": summary, "orientation_density": histogram}),
     )
 }
 
-/// Fig. 2.15: the orientation density of aspect-3 rods in the wedge of angle `alpha` [rad]
-/// and length `ratio` l_w,min (one run, seed 1).
-fn orientation_map(
-    out: &Path,
+/// The run of fig. 2.15: aspect-3 rods in the wedge of angle `alpha` [rad] and length
+/// `ratio` l_w,min (one run, seed 1).
+fn orientation_run(
     n: usize,
     alpha: f64,
     ratio: f64,
-) -> Result<(std::path::PathBuf, serde_json::Value), BenchError> {
+) -> Result<crate::studies::bench::PackingRun, BenchError> {
     let l = 3.0;
     let spec = ContainerSpec::Wedge {
         angle: alpha,
@@ -299,7 +318,17 @@ fn orientation_map(
     let mut cfg = magsep_components::packing::PackingConfig::defaults_for(n, 1.0);
     cfg.initial_packing_fraction = 0.05;
     let n = super::particles_for(&spec, rod(l), n);
-    let run = crate::studies::bench::packing_run_in(n, rod(l), &cfg, 1, f64::INFINITY, &spec)?;
+    crate::studies::bench::packing_run_in(n, rod(l), &cfg, 1, f64::INFINITY, &spec)
+}
+
+/// Fig. 2.15: the orientation density of the rods of [`orientation_run`].
+fn orientation_map(
+    out: &Path,
+    alpha: f64,
+    ratio: f64,
+    run: &crate::studies::bench::PackingRun,
+) -> Result<(std::path::PathBuf, serde_json::Value), BenchError> {
+    let l = 3.0;
     let axes: Vec<glam::DVec3> = (0..run.state.len()).map(|i| run.state.axis(i)).collect();
     let h = orientation_histogram(&axes, 10, 9);
     let d = h.density();

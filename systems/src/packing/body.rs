@@ -4,7 +4,7 @@
 use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
-use crate::geometry::superquadric::Superquadric;
+use crate::geometry::superquadric::{PreparedShape, Superquadric};
 use crate::geometry::{bounding_radius, inertia_body_unit_density, volume};
 
 /// Geometry class of a body: decides the contact routine.
@@ -33,6 +33,11 @@ pub struct Body {
     pub bounding: f64,
     /// Contact class.
     pub kind: BodyKind,
+    /// The body as a superquadric with its contact constants computed once (a rod: its
+    /// circumscribed spheroid), for contacts with superquadrics.
+    pub contact_shape: PreparedShape,
+    /// Whether [`Self::contact_shape`] only approximates the body (a rod of nonzero length).
+    pub contact_approximate: bool,
 }
 
 impl Body {
@@ -67,14 +72,28 @@ impl Body {
             }),
             _ => BodyKind::Rod,
         };
+        let radius = scaled.radius();
+        let half_length = scaled.half_length();
+        let (sq, approximate) = match kind {
+            BodyKind::Superquadric(s) => (s, false),
+            BodyKind::Rod => (
+                Superquadric {
+                    semi_axes: DVec3::new(radius, radius, radius + half_length),
+                    exponents: DVec3::splat(2.0),
+                },
+                half_length > 0.0,
+            ),
+        };
         Self {
-            radius: scaled.radius(),
-            half_length: scaled.half_length(),
+            radius,
+            half_length,
             volume: v,
             inertia,
             xi_default: inertia.x / v,
             bounding: bounding_radius(&scaled),
             kind,
+            contact_shape: PreparedShape::new(&sq),
+            contact_approximate: approximate,
         }
     }
 

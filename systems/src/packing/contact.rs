@@ -9,9 +9,9 @@
 
 use glam::{DQuat, DVec3};
 
-use super::body::{Body, BodyKind};
+use super::body::Body;
 use crate::geometry::segment_closest;
-use crate::geometry::superquadric::{self as sq, ContactOptions, Superquadric};
+use crate::geometry::superquadric::{self as sq, ContactOptions};
 
 /// Contact of particle i with (an image of) particle j.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,13 +119,20 @@ pub fn superquadric_contact(
     qb: DQuat,
     warm: &mut Option<sq::WarmStart>,
 ) -> PairContact {
-    let sa = as_superquadric(a);
-    let sb = as_superquadric(b);
     let opts = ContactOptions {
         gap_cutoff: 0.05,
         ..ContactOptions::default()
     };
-    let r = sq::contact(&sa.0, xa, qa, &sb.0, xb, qb, &opts, warm.as_ref());
+    let r = sq::contact_prepared(
+        &a.contact_shape,
+        xa,
+        qa,
+        &b.contact_shape,
+        xb,
+        qb,
+        &opts,
+        warm.as_ref(),
+    );
     if r.warm.is_some() {
         *warm = r.warm;
     }
@@ -137,19 +144,6 @@ pub fn superquadric_contact(
         t: 0.0,
         rc_i: r.rc_a,
         rc_j: r.rc_b,
-        fallback: sa.1 || sb.1 || r.is_fallback(),
-    }
-}
-
-fn as_superquadric(b: &Body) -> (Superquadric, bool) {
-    match b.kind {
-        BodyKind::Superquadric(s) => (s, false),
-        BodyKind::Rod => (
-            Superquadric {
-                semi_axes: DVec3::new(b.radius, b.radius, b.radius + b.half_length),
-                exponents: DVec3::splat(2.0),
-            },
-            b.half_length > 0.0,
-        ),
+        fallback: a.contact_approximate || b.contact_approximate || r.is_fallback(),
     }
 }

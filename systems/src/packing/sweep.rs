@@ -253,10 +253,10 @@ pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &
     let Some(d) = p.displacement else {
         return false;
     };
-    let body = state.bodies[i];
+    let turn = turn_bound(&state.bodies[i], d.rotation);
     state.positions[i] += d.dx;
     state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
-    list.note_move(i, d.dx, turn_bound(&body, d.rotation));
+    list.note_move(i, d.dx, turn);
     true
 }
 

@@ -163,16 +163,16 @@ pub struct GjkEpaContact {
 }
 
 /// Everything [`contact`] derives from its arguments once.
-struct Setup {
-    pa: Prepared,
-    pb: Prepared,
-    pair: PairFrame,
-    qa: DQuat,
-    qb: DQuat,
-    qab: DQuat,
-    d: DVec3,
+pub(super) struct Setup {
+    pub(super) pa: Prepared,
+    pub(super) pb: Prepared,
+    pub(super) pair: PairFrame,
+    pub(super) qa: DQuat,
+    pub(super) qb: DQuat,
+    pub(super) qab: DQuat,
+    pub(super) d: DVec3,
     /// Smallest semi-axis of the pair.
-    scale: f64,
+    pub(super) scale: f64,
 }
 
 fn setup(
@@ -187,11 +187,35 @@ fn setup(
     if !(finite && a.is_valid() && b.is_valid() && qa.length() > 0.0 && qb.length() > 0.0) {
         return None;
     }
+    let scale = a.semi_axes.min_element().min(b.semi_axes.min_element());
+    Some(pose_setup(
+        a.prepared(),
+        b.prepared(),
+        scale,
+        xa,
+        qa,
+        xb,
+        qb,
+    ))
+}
+
+/// The [`Setup`] of valid shapes (`pa`, `pb`, smallest semi-axis `scale`) at finite poses
+/// with nonzero quaternions.
+#[inline]
+pub(super) fn pose_setup(
+    pa: Prepared,
+    pb: Prepared,
+    scale: f64,
+    xa: DVec3,
+    qa: DQuat,
+    xb: DVec3,
+    qb: DQuat,
+) -> Setup {
     let (qa, qb) = (qa.normalize(), qb.normalize());
     let qbi = qb.conjugate();
-    Some(Setup {
-        pa: a.prepared(),
-        pb: b.prepared(),
+    Setup {
+        pa,
+        pb,
         pair: PairFrame {
             r: DMat3::from_quat(qbi * qa),
             c: qbi * (xa - xb),
@@ -200,11 +224,11 @@ fn setup(
         qb,
         qab: qa.conjugate() * qb,
         d: xb - xa,
-        scale: a.semi_axes.min_element().min(b.semi_axes.min_element()),
-    })
+        scale,
+    }
 }
 
-fn invalid() -> ContactResult {
+pub(super) fn invalid() -> ContactResult {
     ContactResult {
         overlap: f64::NAN,
         normal: DVec3::ZERO,
@@ -292,26 +316,42 @@ pub fn contact(
         return invalid();
     };
     let dist = s.d.length();
-    let far = |bound: f64| ContactResult {
+    let box_bound = a.semi_axes.length() + b.semi_axes.length();
+    if dist > box_bound {
+        return far_apart(s.d, dist, box_bound);
+    }
+    let outer = bounding_radius_cheap(a.semi_axes, a.exponents)
+        + bounding_radius_cheap(b.semi_axes, b.exponents);
+    if dist > outer {
+        return far_apart(s.d, dist, outer);
+    }
+    let inner = a.semi_axes.min_element() + b.semi_axes.min_element();
+    solve_pair(&s, dist, (inner - dist, outer - dist), opts, warm)
+}
+
+/// The [`ContactStatus::FarApart`] answer for centres `d` = x_b - x_a at distance `dist`
+/// beyond the bound `bound` of r_a + r_b.
+pub(super) fn far_apart(d: DVec3, dist: f64, bound: f64) -> ContactResult {
+    ContactResult {
         overlap: bound - dist,
-        normal: s.d.try_normalize().unwrap_or(DVec3::X),
+        normal: d.try_normalize().unwrap_or(DVec3::X),
         rc_a: DVec3::ZERO,
         rc_b: DVec3::ZERO,
         status: ContactStatus::FarApart,
         iterations: 0,
         warm: None,
-    };
-    let box_bound = a.semi_axes.length() + b.semi_axes.length();
-    if dist > box_bound {
-        return far(box_bound);
     }
-    let outer = bounding_radius_cheap(a.semi_axes, a.exponents)
-        + bounding_radius_cheap(b.semi_axes, b.exponents);
-    if dist > outer {
-        return far(outer);
-    }
-    let inner = a.semi_axes.min_element() + b.semi_axes.min_element();
-    let bounds = (inner - dist, outer - dist);
+}
+
+/// [`contact`] after the bounding-sphere rejects: `bounds` = (inscribed, circumscribed)
+/// sphere bounds of the overlap.
+pub(super) fn solve_pair(
+    s: &Setup,
+    dist: f64,
+    bounds: (f64, f64),
+    opts: &ContactOptions,
+    warm: Option<&WarmStart>,
+) -> ContactResult {
     let tol = if opts.tolerance > 0.0 {
         opts.tolerance
     } else {

@@ -56,6 +56,7 @@ impl Frame {
 
     /// Frame of `m` reflected along axis `axis` (needs m_axis != 0 unless the other two
     /// components are nonzero; `None` when |h| = 0 or anything is not finite).
+    #[inline]
     pub fn with_axis(m: DVec3, axis: usize) -> Option<Self> {
         let mn = m.length();
         if !(mn.is_finite() && mn > 0.0) {

@@ -67,6 +67,7 @@
 //! assert!((c.dist + 0.5).abs() < 1e-6);
 //! ```
 
+mod cached;
 mod contact;
 mod householder;
 mod mass;
@@ -78,10 +79,13 @@ mod shape;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_cached;
+#[cfg(test)]
 mod tests_contact;
 #[cfg(test)]
 mod tests_random;
 
+pub use cached::{PreparedShape, contact_prepared};
 pub use contact::{
     ContactOptions, ContactResult, ContactStatus, GjkEpaContact, WarmStart, contact,
     gjk_epa_contact,

@@ -39,6 +39,9 @@ impl Pow {
     fn apply(self, y: f64) -> f64 {
         match self {
             Pow::One => 1.0,
+            // y^1 and y^2 as the compiler's `powi` computes them (bit for bit, no call)
+            Pow::Int(1) => y,
+            Pow::Int(2) => y * y,
             Pow::Int(n) => y.powi(n),
             Pow::Real(e) => y.powf(e),
         }
@@ -263,4 +266,25 @@ pub(crate) fn monotone_log_newton(lb: &[f64; 3], p: &[f64; 3], t0: f64) -> f64 {
         }
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Pow;
+
+    /// The integer powers' fast paths equal `powi` (their reference) bit for bit.
+    #[test]
+    fn integer_powers_equal_powi() {
+        let mut y = 1e-3;
+        while y < 3.0 {
+            for n in 1..=16 {
+                assert_eq!(
+                    Pow::Int(n).apply(y).to_bits(),
+                    y.powi(n).to_bits(),
+                    "{y}^{n}"
+                );
+            }
+            y *= 1.013;
+        }
+    }
 }
