@@ -141,15 +141,15 @@ pub fn chart(sweep: &Sweep, curve: &Curve, g: &Gathered) -> Option<Chart> {
     Some(chart)
 }
 
+/// Points left out of each curve, by curve name.
+pub type LeftOut = Vec<(String, usize)>;
+
 /// Write every curve's CSV into `out/curves` and chart into `out/charts`; returns the files
 /// and the number of points left out of each curve (by name).
 ///
 /// # Errors
 /// A write failure, naming the file.
-pub fn write_curves(
-    sweep: &Sweep,
-    out: &Path,
-) -> Result<(Vec<PathBuf>, Vec<(String, usize)>), String> {
+pub fn write_curves(sweep: &Sweep, out: &Path) -> Result<(Vec<PathBuf>, LeftOut), String> {
     let mut files = Vec::new();
     let mut left_out = Vec::new();
     for curve in &sweep.curves {

@@ -416,7 +416,7 @@ pub(super) fn solve_pair(
     {
         let nw = newton::solve(&s.pa, &s.pb, &s.pair, w.s_a, w.s_b, &set);
         iterations += nw.iterations;
-        if let Some((overlap, u)) = accept(&s, &nw, bounds, None, slack, tol) {
+        if let Some((overlap, u)) = accept(s, &nw, bounds, None, slack, tol) {
             return converged(&nw, overlap, u, iterations);
         }
     }
@@ -465,7 +465,7 @@ pub(super) fn solve_pair(
     let upper = (seed.kind != SeedKind::Failed).then_some(seed.overlap);
     let nw = newton::solve(&s.pa, &s.pb, &s.pair, seed.s_a, seed.s_b, &set);
     iterations += nw.iterations;
-    if let Some((overlap, u)) = accept(&s, &nw, bounds, upper, slack, tol) {
+    if let Some((overlap, u)) = accept(s, &nw, bounds, upper, slack, tol) {
         return converged(&nw, overlap, u, iterations);
     }
     // retry once from the centre line
@@ -473,7 +473,7 @@ pub(super) fn solve_pair(
     let (s_a, s_b, _) = seed_from(&s.pa, &s.pb, &s.pair, centre);
     let nw = newton::solve(&s.pa, &s.pb, &s.pair, s_a, s_b, &set);
     iterations += nw.iterations;
-    if let Some((overlap, u)) = accept(&s, &nw, bounds, upper, slack, tol) {
+    if let Some((overlap, u)) = accept(s, &nw, bounds, upper, slack, tol) {
         return converged(&nw, overlap, u, iterations);
     }
     seed_result(ContactStatus::Fallback, iterations)
