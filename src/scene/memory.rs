@@ -105,19 +105,24 @@ pub fn estimate(scene: &Scene) -> MemoryEstimate {
 pub fn check(scene: &Scene, budget: u64) -> Result<MemoryEstimate, SceneError> {
     let estimate = estimate(scene);
     if estimate.bytes > budget as f64 || !estimate.bytes.is_finite() {
-        return Err(SceneError::new(
-            estimate.key.clone(),
-            format!(
-                "the scene needs about {} of memory ({}), more than the budget of {}; \
-                 make it smaller, or raise the budget with --memory-budget <GiB> \
-                 (or MAGSEP_MEMORY_BUDGET) if the machine has the memory",
-                gib(estimate.bytes),
-                estimate.detail,
-                gib(budget as f64)
-            ),
-        ));
+        return Err(over_budget(&estimate, budget));
     }
     Ok(estimate)
+}
+
+/// The error of an `estimate` over `budget` \[bytes\], at the estimate's key.
+pub fn over_budget(estimate: &MemoryEstimate, budget: u64) -> SceneError {
+    SceneError::new(
+        estimate.key.clone(),
+        format!(
+            "the scene needs about {} of memory ({}), more than the budget of {}; \
+             make it smaller, or raise the budget with --memory-budget <GiB> \
+             (or MAGSEP_MEMORY_BUDGET) if the machine has the memory",
+            gib(estimate.bytes),
+            estimate.detail,
+            gib(budget as f64)
+        ),
+    )
 }
 
 /// `bytes` in GiB for messages.

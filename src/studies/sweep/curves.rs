@@ -15,7 +15,7 @@ use serde_json::Value;
 
 use super::chart::{label, leads, mean_ci95, slug};
 use super::file::{Curve, Sweep, value_cell};
-use super::run::{Outcome, outcome};
+use super::run::Outcome;
 use crate::chart::{Chart, PALETTE, Series, Style, write_svg};
 
 /// The replicates of one combination of axis values.
@@ -42,15 +42,15 @@ fn numbers(v: Option<&Value>) -> Option<Vec<f64>> {
     v?.as_array()?.iter().map(Value::as_f64).collect()
 }
 
-/// Gather `curve` from the finished points of `sweep` in `out`.
-pub fn gather(sweep: &Sweep, out: &Path, curve: &Curve) -> Gathered {
+/// Gather `curve` from the finished points of `sweep` (`outcomes[i]`: point i's outcome).
+pub fn gather(sweep: &Sweep, outcomes: &[Outcome], curve: &Curve) -> Gathered {
     let mut g = Gathered::default();
-    for index in 0..sweep.len() {
-        let Outcome::Ok(summary) = outcome(out, index) else {
+    for (index, outcome) in outcomes.iter().enumerate() {
+        let Outcome::Ok(summary) = outcome else {
             continue;
         };
-        let x = numbers(curve.x.1.lookup_json(&summary));
-        let y = numbers(curve.y.1.lookup_json(&summary));
+        let x = numbers(curve.x.1.lookup_json(summary));
+        let y = numbers(curve.y.1.lookup_json(summary));
         let (Some(x), Some(y)) = (x, y) else {
             g.left_out += 1;
             continue;
@@ -144,16 +144,21 @@ pub fn chart(sweep: &Sweep, curve: &Curve, g: &Gathered) -> Option<Chart> {
 /// Points left out of each curve, by curve name.
 pub type LeftOut = Vec<(String, usize)>;
 
-/// Write every curve's CSV into `out/curves` and chart into `out/charts`; returns the files
-/// and the number of points left out of each curve (by name).
+/// Write every curve's CSV into `out/curves` and chart into `out/charts` from the points'
+/// `outcomes` (indexed by point); returns the files and the number of points left out of
+/// each curve (by name).
 ///
 /// # Errors
 /// A write failure, naming the file.
-pub fn write_curves(sweep: &Sweep, out: &Path) -> Result<(Vec<PathBuf>, LeftOut), String> {
+pub fn write_curves(
+    sweep: &Sweep,
+    outcomes: &[Outcome],
+    out: &Path,
+) -> Result<(Vec<PathBuf>, LeftOut), String> {
     let mut files = Vec::new();
     let mut left_out = Vec::new();
     for curve in &sweep.curves {
-        let g = gather(sweep, out, curve);
+        let g = gather(sweep, outcomes, curve);
         left_out.push((curve.name.clone(), g.left_out));
         let dir = out.join("curves");
         std::fs::create_dir_all(&dir)

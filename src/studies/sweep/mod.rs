@@ -70,16 +70,19 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
 ///
 /// # Errors
 /// [`SweepError::Input`] with the failing points and key paths.
-pub fn load_checked(path: &Path, registry: &Registry) -> Result<Sweep, SweepError> {
+pub fn load_checked(
+    path: &Path,
+    registry: &Registry,
+) -> Result<(Sweep, Vec<run::PointMemory>), SweepError> {
     let sweep = load(path)?;
     let all: Vec<usize> = (0..sweep.len()).collect();
-    check_points(&sweep, registry, &all).map_err(|e| {
+    let memory = check_points(&sweep, registry, &all).map_err(|e| {
         SweepError::Input(format!(
             "{} is invalid: a point's scene does not validate:\n{e}",
             path.display()
         ))
     })?;
-    Ok(sweep)
+    Ok((sweep, memory))
 }
 
 /// The files of `out` a sweep writes, which must not be its inputs.
@@ -130,7 +133,7 @@ pub fn run_sweep(
     bar: &ProgressBar,
 ) -> Result<Value, SweepError> {
     let started = Instant::now();
-    let sweep = load_checked(&args.sweep, registry)?;
+    let (sweep, memory) = load_checked(&args.sweep, registry)?;
     check_inputs(&args.sweep, &sweep, &args.out)?;
     open_dir(&sweep, &args.out).map_err(|(input, m)| {
         if input {
@@ -150,7 +153,7 @@ pub fn run_sweep(
         })
         .collect();
     let (jobs, largest) =
-        run::jobs_within_budget(&sweep, registry, &todo, args.jobs, args.memory_budget).map_err(
+        run::jobs_within_budget(&sweep, &memory, &todo, args.jobs, args.memory_budget).map_err(
             |e| {
                 SweepError::Input(format!(
                     "{}: a point's scene needs more memory than the budget:\n{e}",
@@ -207,13 +210,15 @@ pub fn run_sweep(
 /// # Errors
 /// An I/O failure.
 pub fn finish(sweep: &Sweep, out: &Path) -> Result<Value, SweepError> {
-    let rows = table::gather(sweep, out);
+    let outcomes = run::outcomes(sweep, out);
+    let rows = table::gather(sweep, &outcomes);
     let csv = table::csv_text(sweep, &rows).map_err(SweepError::Runtime)?;
     let results = out.join("results.csv");
     write_atomic(&results, &csv).map_err(SweepError::Runtime)?;
     let charts =
         chart::write_charts(sweep, &rows, &out.join("charts")).map_err(SweepError::Runtime)?;
-    let (curve_files, left_out) = curves::write_curves(sweep, out).map_err(SweepError::Runtime)?;
+    let (curve_files, left_out) =
+        curves::write_curves(sweep, &outcomes, out).map_err(SweepError::Runtime)?;
     let (ok, error, missing) = table::counts(&rows);
     let absent: serde_json::Map<String, Value> = table::absent_values(sweep, &rows)
         .into_iter()
@@ -291,7 +296,7 @@ pub fn write_slurm(
             slurm::check_word(flag, v).map_err(SweepError::Input)?;
         }
     }
-    let sweep = load_checked(sweep_path, registry)?;
+    let (sweep, _) = load_checked(sweep_path, registry)?;
     check_inputs(sweep_path, &sweep, out)?;
     let abs = |p: &Path| {
         std::path::absolute(p).map_err(|e| SweepError::Runtime(format!("{}: {e}", p.display())))

@@ -75,28 +75,37 @@ pub fn point_scene(
 /// Most failing points listed in the error of [`check_points`].
 const MAX_LISTED: usize = 10;
 
-/// Validate the scene of every point of `indices` before anything runs.
+/// Validate the scene of every point of `indices` before anything runs, and estimate each
+/// one's memory (the scenes are built once, here).
 ///
 /// # Errors
 /// The failing points (up to ten listed), each with its overrides and key-path errors.
-pub fn check_points(sweep: &Sweep, registry: &Registry, indices: &[usize]) -> Result<(), String> {
+pub fn check_points(
+    sweep: &Sweep,
+    registry: &Registry,
+    indices: &[usize],
+) -> Result<Vec<PointMemory>, String> {
     let base = base_document(sweep).map_err(|e| format!("scene: {e}"))?;
     let mut failing = Vec::new();
+    let mut estimates = Vec::with_capacity(indices.len());
     let mut count = 0;
     for &i in indices {
         let point = sweep.point(i);
-        if let Err(e) = point_scene(sweep, &base, &point, registry) {
-            count += 1;
-            if failing.len() < MAX_LISTED {
-                let ovs: Vec<String> = (sweep.overrides(&point).iter())
-                    .map(ToString::to_string)
-                    .collect();
-                failing.push(format!("point {i} ({}):\n{e}", ovs.join(" ")));
+        match point_scene(sweep, &base, &point, registry) {
+            Ok(scene) => estimates.push(PointMemory {
+                index: i,
+                estimate: crate::scene::memory::estimate(&scene),
+            }),
+            Err(e) => {
+                count += 1;
+                if failing.len() < MAX_LISTED {
+                    failing.push(format!("point {i} ({}):\n{e}", point_overrides(sweep, i)));
+                }
             }
         }
     }
     if count == 0 {
-        return Ok(());
+        return Ok(estimates);
     }
     let more = if count > failing.len() {
         format!("\n... and {} more points", count - failing.len())
@@ -106,37 +115,56 @@ pub fn check_points(sweep: &Sweep, registry: &Registry, indices: &[usize]) -> Re
     Err(format!("{}{more}", failing.join("\n")))
 }
 
-/// How many of `jobs` points may run at once within `budget` \[bytes\]: each point of
-/// `indices` must fit alone (else an error naming the point and the key that drives its
+/// One point's memory estimate, from [`check_points`].
+#[derive(Debug, Clone)]
+pub struct PointMemory {
+    /// The point's index in the sweep.
+    pub index: usize,
+    /// Its scene's estimate.
+    pub estimate: crate::scene::memory::MemoryEstimate,
+}
+
+/// The overrides of point `i`, space-separated, for messages.
+fn point_overrides(sweep: &Sweep, i: usize) -> String {
+    let ovs: Vec<String> = (sweep.overrides(&sweep.point(i)).iter())
+        .map(ToString::to_string)
+        .collect();
+    ovs.join(" ")
+}
+
+/// How many of `jobs` points may run at once within `budget` \[bytes\]: each of the points
+/// `todo` must fit alone (else an error naming the point and the key that drives its
 /// estimate), and the `J` largest estimates together, so `J` is lowered until they do.
-/// Returns `J` (at least 1) and the largest estimate \[bytes\].
+/// `memory` holds the estimates of [`check_points`] (points missing from it were reported
+/// there). Returns `J` (at least 1) and the largest estimate \[bytes\].
 ///
 /// # Errors
 /// The points over the budget (up to ten listed).
 pub fn jobs_within_budget(
     sweep: &Sweep,
-    registry: &Registry,
-    indices: &[usize],
+    memory: &[PointMemory],
+    todo: &[usize],
     jobs: usize,
     budget: u64,
 ) -> Result<(usize, f64), String> {
-    let base = base_document(sweep).map_err(|e| format!("scene: {e}"))?;
-    let mut estimates = Vec::with_capacity(indices.len());
+    let mut todo = todo.to_vec();
+    todo.sort_unstable();
+    let mut estimates = Vec::with_capacity(todo.len());
     let mut failing = Vec::new();
-    for &i in indices {
-        let point = sweep.point(i);
-        let Ok(scene) = point_scene(sweep, &base, &point, registry) else {
-            continue; // reported by check_points
-        };
-        match crate::scene::memory::check(&scene, budget) {
-            Ok(e) => estimates.push(e.bytes),
-            Err(e) if failing.len() < MAX_LISTED => {
-                let ovs: Vec<String> = (sweep.overrides(&point).iter())
-                    .map(ToString::to_string)
-                    .collect();
-                failing.push(format!("point {i} ({}):\n{e}", ovs.join(" ")));
-            }
-            Err(_) => {}
+    for m in memory
+        .iter()
+        .filter(|m| todo.binary_search(&m.index).is_ok())
+    {
+        let e = &m.estimate;
+        if e.bytes <= budget as f64 && e.bytes.is_finite() {
+            estimates.push(e.bytes);
+        } else if failing.len() < MAX_LISTED {
+            let err = crate::scene::memory::over_budget(e, budget);
+            failing.push(format!(
+                "point {} ({}):\n{err}",
+                m.index,
+                point_overrides(sweep, m.index)
+            ));
         }
     }
     if !failing.is_empty() {
@@ -209,6 +237,11 @@ pub fn open_dir(sweep: &Sweep, out: &Path) -> Result<(), (bool, String)> {
         }
         Err(e) => Err((false, format!("cannot read {}: {e}", path.display()))),
     }
+}
+
+/// The outcome of every point of `sweep` in `out`, indexed by point (each summary read once).
+pub fn outcomes(sweep: &Sweep, out: &Path) -> Vec<Outcome> {
+    (0..sweep.len()).map(|i| outcome(out, i)).collect()
 }
 
 /// How point `index` ended, from its directory in `out`.

@@ -1,11 +1,9 @@
 //! The results table of a sweep (`results.csv`): one row per point.
 
-use std::path::Path;
-
 use serde_json::Value;
 
 use super::file::{Sweep, value_cell};
-use super::run::{Outcome, outcome};
+use super::run::Outcome;
 
 /// One point's row.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,18 +31,19 @@ impl Row {
     }
 }
 
-/// The rows of every point of `sweep`, read from the sweep directory `out`.
-pub fn gather(sweep: &Sweep, out: &Path) -> Vec<Row> {
-    (0..sweep.len())
-        .map(|index| {
+/// The rows of every point of `sweep` from their `outcomes` (indexed by point, see
+/// [`super::run::outcomes`]).
+pub fn gather(sweep: &Sweep, outcomes: &[Outcome]) -> Vec<Row> {
+    (outcomes.iter().enumerate())
+        .map(|(index, outcome)| {
             let point = sweep.point(index);
-            let (status, summary, error) = match outcome(out, index) {
+            let (status, summary, error) = match outcome {
                 Outcome::Ok(s) => ("ok", Some(s), String::new()),
-                Outcome::Failed { error, summary } => ("error", summary, error),
+                Outcome::Failed { error, summary } => ("error", summary.as_ref(), error.clone()),
                 Outcome::Missing => ("missing", None, String::new()),
             };
             let collected = (sweep.collect.iter())
-                .map(|(_, p)| summary.as_ref().and_then(|s| p.lookup_json(s)).cloned())
+                .map(|(_, p)| summary.and_then(|s| p.lookup_json(s)).cloned())
                 .collect();
             Row {
                 index,
