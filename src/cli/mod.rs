@@ -101,9 +101,11 @@ enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
     },
-    /// Validate a scene: exit 0 if valid, 2 with every error (and its key path) if not.
+    /// Validate a scene or a sweep file: exit 0 if valid, 2 with every error (and its key
+    /// path) if not. A sweep file is checked point by point (every point's scene, each within
+    /// the memory budget).
     Validate {
-        /// Scene file (TOML).
+        /// Scene or sweep file (TOML).
         scene: PathBuf,
         /// Override a scene value: PATH=VALUE (as for `run`).
         #[arg(long = "set", value_name = "PATH=VALUE")]

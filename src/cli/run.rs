@@ -103,12 +103,32 @@ fn memory(
     Ok((estimate, budget))
 }
 
+/// Whether `text` is a sweep file rather than a scene: a top-level `scene` string and no
+/// `[simulation]` table (a scene's `simulation` is required, so nothing is misread).
+fn is_sweep_file(text: &str) -> bool {
+    match text.parse::<toml::Table>() {
+        Ok(t) => t.get("scene").is_some_and(toml::Value::is_str) && !t.contains_key("simulation"),
+        Err(_) => false,
+    }
+}
+
+/// `magsep validate`: a scene (with its overrides and memory estimate), or a sweep file (every
+/// point's scene, see [`super::sweep::validate`]).
 pub fn validate(
     ext: &Extensions,
     path: &Path,
     set: &[String],
     budget_gib: Option<f64>,
 ) -> Result<(), CliError> {
+    if is_sweep_file(&scene_text(path)?) {
+        if !set.is_empty() {
+            return Err(CliError::input(format!(
+                "{}: --set applies to scenes; a sweep file sets values with its axes",
+                path.display()
+            )));
+        }
+        return super::sweep::validate(ext, path, budget_gib);
+    }
     let (text, overrides) = text_with_overrides(path, set)?;
     let scene = parse_with_overrides(ext, path, &text, overrides)?;
     let (estimate, budget) = memory(&scene, path, budget_gib)?;

@@ -1,7 +1,7 @@
 //! `magsep sweep SWEEP.toml --out DIR`, `magsep sweep merge DIR`, `magsep sweep slurm
 //! SWEEP.toml --out DIR` (see `crate::studies::sweep`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -86,6 +86,31 @@ fn to_cli(e: SweepError) -> CliError {
 
 fn pretty(v: &serde_json::Value) -> String {
     serde_json::to_string_pretty(v).unwrap_or_default()
+}
+
+/// `magsep validate SWEEP.toml`: the sweep file and every point's scene, each point within the
+/// memory budget alone (exit 2 with the failing points' key paths otherwise).
+pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Result<(), CliError> {
+    let budget = crate::scene::memory::budget(budget_gib).map_err(CliError::input)?;
+    let (sweep, memory) = sweep::load_checked(path, &ext.registry).map_err(to_cli)?;
+    let all: Vec<usize> = (0..sweep.len()).collect();
+    let (_, largest) =
+        sweep::run::jobs_within_budget(&sweep, &memory, &all, 1, budget).map_err(|e| {
+            CliError::input(format!(
+                "{}: a point's scene needs more memory than the budget:\n{e}",
+                path.display()
+            ))
+        })?;
+    print(pretty(&serde_json::json!({
+        "valid": true,
+        "sweep": path.display().to_string(),
+        "scene": sweep.scene_path.display().to_string(),
+        "points": sweep.len(),
+        "axes": sweep.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
+        "replicates": sweep.replicates,
+        "largest_memory_estimate_bytes": largest.round() as u64,
+        "memory_budget_bytes": budget,
+    })))
 }
 
 /// Run `magsep sweep ...`.

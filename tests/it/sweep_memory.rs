@@ -74,4 +74,8 @@ fn a_point_over_the_budget_alone_fails_up_front_at_its_key() {
         "{e}"
     );
     assert!(!Path::new(&out).join("points/0/summary.json").exists());
+    // `magsep validate` of the sweep file finds the same point
+    let v = magsep(&["validate", &s, "--memory-budget", "1"]);
+    assert_eq!(v.status.code(), Some(2), "{}", stderr(&v));
+    assert!(stderr(&v).contains("point 1"), "{}", stderr(&v));
 }

@@ -1,7 +1,8 @@
 //! `magsep sweep`: resumable after a kill, shards merged equal the unsharded sweep byte for
 //! byte, partial merges, up-front validation of every point, the Slurm scripts (run here
 //! task by task with `bash`, as Slurm would), a failing point recorded, not fatal, and run
-//! again only with `--retry-failed`, and recordings written with `--record`.
+//! again only with `--retry-failed`, recordings written with `--record`, and `magsep validate`
+//! of sweep files.
 
 use crate::common::{magsep, stderr};
 use std::path::{Path, PathBuf};
@@ -393,7 +394,28 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
             !Path::new(&o_dir).join("points").exists(),
             "case {k} ran points"
         );
+        // `magsep validate` checks a sweep file the same way, without running anything
+        let v = magsep(&["validate", &sweep]);
+        assert_eq!(
+            v.status.code(),
+            Some(2),
+            "validate case {k}: {}",
+            stderr(&v)
+        );
+        assert!(
+            stderr(&v).contains(key),
+            "validate case {k}: {}",
+            stderr(&v)
+        );
     }
+    let good = write_sweep(&dir, SWEEP);
+    let v = json(&magsep(&["validate", &good]));
+    assert_eq!(
+        (v["valid"].as_bool(), v["points"].as_u64()),
+        (Some(true), Some(24))
+    );
+    let o = magsep(&["validate", &good, "--set", "brownian.duration=1.0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     // a point whose scene validates but fails to run is that point's error, not the sweep's
     let text = "scene = \"base.toml\"\ncollect = [\"steps\"]\n[[axes]]\n\
                 path = \"particles[0].count\"\nvalues = [1, 20000]\n[[axes]]\n\
