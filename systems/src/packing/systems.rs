@@ -192,13 +192,11 @@ pub fn remove_overlaps_mcm(
         ids: &ws.ids,
         time: clock.as_ref().map(|c| c.time()).unwrap_or(0.0),
     });
-    ws.outcome = Some(super::compress::run_removal_with(
-        &p,
-        &mut ws.state,
-        &mut ws.list,
-        &mut ws.rng,
-        packing_kernels.as_ref(),
-    ));
+    let (state, list, rng) = (&mut ws.state, &mut ws.list, &mut ws.rng);
+    // many short parallel loops in a row: run them from inside rayon's pool
+    ws.outcome = Some(crate::par::in_rayon_pool(|| {
+        super::compress::run_removal_with(&p, state, list, rng, packing_kernels.as_ref())
+    }));
 }
 
 /// Finalize: accept the step, or revert and refine it; decide whether the run ends.
