@@ -11,7 +11,7 @@
 //! of exact Zuk overlap blocks ([`rpy_coefficients`]); the self block is I/(6πηa_i).
 //!
 //! Preparation is O(N) plus the overlap search; each product is O(N²) flops with O(N) memory
-//! (the stored alternative, [`super::near::Near`] with ξ = 0, keeps 40 bytes per pair and
+//! (the stored alternative, [`super::near::Near`] with ξ = 0, keeps 20 bytes per pair and
 //! spends most of its time building them). Rows are independent and each is summed in a
 //! fixed order (lane l takes j ≡ l mod 8, lanes combined pairwise in a fixed tree, then the
 //! overlap blocks), so the result is bitwise the same for every thread count.

@@ -137,6 +137,12 @@ impl SpectralEwald {
         Self { params, real, wave }
     }
 
+    /// The wave-space operator (None for the direct sum), for the tests.
+    #[cfg(test)]
+    pub fn wave(&self) -> Option<&Wave> {
+        self.wave.as_ref()
+    }
+
     /// out = μ x for flat 3N vectors.
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
         match &self.real {

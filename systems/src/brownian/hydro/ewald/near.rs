@@ -20,17 +20,20 @@ use crate::brownian::hydro::rpy::{rpy_coefficients, self_mobility};
 const ROWS: usize = 64;
 
 /// CSR block matrix: row i's blocks are `blocks[start[i]..start[i + 1]]` with columns `cols`;
-/// blocks stored as (iso, dyad factor, d) with block = iso I + f d dᵀ.
+/// blocks stored as (iso, dyad factor f) with block = iso I + f d dᵀ, d = x_i − x_j recomputed
+/// from the stored positions in every product (the same bits as when the block was made;
+/// 20 instead of 44 bytes per block read per product).
 #[derive(Debug)]
 pub(crate) struct Near {
     start: Vec<usize>,
     cols: Vec<u32>,
-    blocks: Vec<(f64, f64, DVec3)>,
+    blocks: Vec<(f64, f64)>,
     diag: Vec<f64>,
+    positions: Vec<DVec3>,
 }
 
 /// One row of the pair list: columns and blocks.
-type Row = (Vec<u32>, Vec<(f64, f64, DVec3)>);
+type Row = (Vec<u32>, Vec<(f64, f64)>);
 
 /// (iso, dyad) in SI of the pair block of particles at separation r with radii a_i, a_j.
 fn pair(r: f64, a_i: f64, a_j: f64, viscosity: f64, xi: f64) -> (f64, f64) {
@@ -75,7 +78,7 @@ impl Near {
                     let (iso, dyad) = pair(r, radii[i], radii[j], viscosity, xi);
                     let f = if r > 0.0 { dyad / (r * r) } else { 0.0 };
                     cols.push(j as u32);
-                    blocks.push((iso, f, d));
+                    blocks.push((iso, f));
                 };
                 match &cells {
                     Some(c) => c.for_each_neighbour(positions, i, params.cutoff, &mut add),
@@ -111,6 +114,7 @@ impl Near {
             cols,
             blocks,
             diag,
+            positions: positions.to_vec(),
         }
     }
 
@@ -125,9 +129,11 @@ impl Near {
             for (r, oi) in o.chunks_exact_mut(3).enumerate() {
                 let i = k * ROWS + r;
                 let mut acc = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]) * self.diag[i];
+                let xi = self.positions[i];
                 for b in self.start[i]..self.start[i + 1] {
                     let j = self.cols[b] as usize;
-                    let (iso, f, d) = self.blocks[b];
+                    let (iso, f) = self.blocks[b];
+                    let d = xi - self.positions[j];
                     let xj = DVec3::new(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
                     acc += xj * iso + d * (f * d.dot(xj));
                 }

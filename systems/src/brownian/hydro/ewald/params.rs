@@ -31,7 +31,7 @@ pub(crate) const SPLIT: f64 = 0.6;
 /// Largest FFT length per side (memory: about 100 n³ bytes while preparing the kernel).
 pub const MAX_FFT: usize = 320;
 
-/// Largest number of stored pair blocks (40 bytes each).
+/// Largest number of stored pair blocks (20 bytes each).
 pub const MAX_PAIR_BLOCKS: f64 = 5e7;
 
 /// Smallest accepted tolerance (below it rounding in the FFTs dominates).

@@ -210,9 +210,103 @@ impl Wave {
         }
     }
 
-    /// Spread `nf` interleaved source fields (`src(i)` gives particle i's values) onto the
-    /// compact grid, layout `((ix * m + iy) * m + iz) * nf + c`.
-    fn spread(&self, nf: usize, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
+    /// Spread `NF` interleaved source fields (`src(i, c)` gives particle i's value c) onto
+    /// the compact grid, layout `((ix * m + iy) * m + iz) * NF + c`. Per particle and x-plane
+    /// the P·NF products (source × z weight) are formed once, then every (x, y) row of the
+    /// support is one contiguous axpy of length P·NF (vectorised). Equal to the plain loop
+    /// [`Wave::spread_reference`] up to rounding (tested).
+    fn spread<const NF: usize>(&self, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
+        let (m, p) = (self.fft.m, self.support);
+        let mut grid = vec![0.0; m * m * m * NF];
+        grid.par_chunks_mut(m * m * NF)
+            .enumerate()
+            .for_each(|(ix, plane)| {
+                let mut t = vec![0.0; p * NF];
+                for &i in &self.plane_members[ix] {
+                    let i = i as usize;
+                    let s = self.start[i];
+                    let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+                    let wx = w[ix - s[0]];
+                    let mut q = [0.0; NF];
+                    for (c, qc) in q.iter_mut().enumerate() {
+                        *qc = src(i, c) * wx;
+                    }
+                    for (tb, wz) in t.chunks_exact_mut(NF).zip(&w[2 * p..3 * p]) {
+                        for (tc, qc) in tb.iter_mut().zip(&q) {
+                            *tc = qc * wz;
+                        }
+                    }
+                    for (a, wy) in w[p..2 * p].iter().enumerate() {
+                        let row0 = ((s[1] + a) * m + s[2]) * NF;
+                        for (o, tv) in plane[row0..row0 + p * NF].iter_mut().zip(&t) {
+                            *o += wy * tv;
+                        }
+                    }
+                }
+            });
+        grid
+    }
+
+    /// Gather the `NF` interleaved fields at particle `i`; `acc` is scratch of length P·NF.
+    /// Every (x, y) row of the support is one contiguous axpy of length P·NF into `acc`,
+    /// reduced with the z weights at the end. Equal to [`Wave::gather_reference`] up to
+    /// rounding (tested).
+    fn gather<const NF: usize>(&self, grid: &[f64], i: usize, acc: &mut [f64]) -> [f64; NF] {
+        let (m, p) = (self.fft.m, self.support);
+        let s = self.start[i];
+        let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+        acc.fill(0.0);
+        for (a, wx) in w[..p].iter().enumerate() {
+            for (b, wy) in w[p..2 * p].iter().enumerate() {
+                let c = wx * wy;
+                let base = (((s[0] + a) * m + s[1] + b) * m + s[2]) * NF;
+                for (ac, g) in acc.iter_mut().zip(&grid[base..base + p * NF]) {
+                    *ac += c * g;
+                }
+            }
+        }
+        let mut out = [0.0; NF];
+        for (ab, wz) in acc.chunks_exact(NF).zip(&w[2 * p..3 * p]) {
+            for (o, v) in out.iter_mut().zip(ab) {
+                *o += wz * v;
+            }
+        }
+        out
+    }
+
+    /// The wave-space velocities of `f` (flat 3N) in the reference form (the plain
+    /// spreading and gathering loops) for the tests of the fast path.
+    #[cfg(test)]
+    pub fn apply_reference(&self, f: &[f64]) -> Vec<f64> {
+        let nf = if self.kernel_l.is_some() { 6 } else { 3 };
+        let grid = self.spread_reference(nf, &|i, c| self.source(f, i, c));
+        let field = self.convolve(&grid, nf);
+        (0..self.start.len())
+            .flat_map(|i| self.combine(&self.gather_reference(&field, nf, i), i))
+            .collect()
+    }
+
+    /// Source field c of particle i: f (c < 3), a²f (c ≥ 3).
+    #[inline]
+    fn source(&self, f: &[f64], i: usize, c: usize) -> f64 {
+        if c < 3 {
+            f[3 * i + c]
+        } else {
+            self.radii_sq[i] * f[3 * i + c - 3]
+        }
+    }
+
+    /// Velocity of particle i from its gathered fields: the second field group is
+    /// (L̃∗f)/6, weighted by the target's a².
+    #[inline]
+    fn combine(&self, g: &[f64], i: usize) -> [f64; 3] {
+        let a2 = self.radii_sq[i];
+        std::array::from_fn(|k| g[k] + g.get(3 + k).map_or(0.0, |e| a2 * e))
+    }
+
+    /// Reference spreading (plain loops, any `nf`) for the tests.
+    #[cfg(test)]
+    fn spread_reference(&self, nf: usize, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
         let (m, p) = (self.fft.m, self.support);
         let mut grid = vec![0.0; m * m * m * nf];
         grid.par_chunks_mut(m * m * nf)
@@ -243,8 +337,9 @@ impl Wave {
         grid
     }
 
-    /// Gather the `nf` interleaved fields at particle `i`.
-    fn gather(&self, grid: &[f64], nf: usize, i: usize) -> [f64; 6] {
+    /// Reference gathering (plain loops) for the tests.
+    #[cfg(test)]
+    fn gather_reference(&self, grid: &[f64], nf: usize, i: usize) -> [f64; 6] {
         let (m, p) = (self.fft.m, self.support);
         let s = self.start[i];
         let w = &self.weights[3 * p * i..3 * p * (i + 1)];
@@ -274,28 +369,46 @@ impl Wave {
 
     /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
     pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
+        let p = self.support;
+        if self.kernel_l.is_some() {
+            let grid = self.spread::<6>(&|i, c| self.source(f, i, c));
+            let field = self.convolve(&grid, 6);
+            out.par_chunks_mut(3).enumerate().for_each_init(
+                || vec![0.0; 6 * p],
+                |acc, (i, o)| {
+                    let v = self.combine(&self.gather::<6>(&field, i, acc), i);
+                    o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
+                },
+            );
+        } else {
+            let grid = self.spread::<3>(&|i, c| f[3 * i + c]);
+            let field = self.convolve(&grid, 3);
+            out.par_chunks_mut(3).enumerate().for_each_init(
+                || vec![0.0; 3 * p],
+                |acc, (i, o)| {
+                    let v = self.gather::<3>(&field, i, acc);
+                    o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
+                },
+            );
+        }
+    }
+
+    /// The grid convolution of the `nf` spread fields with the kernel(s): forward FFTs,
+    /// the 3×3 kernel products per wavenumber, inverse FFTs to the compact grid.
+    fn convolve(&self, grid: &[f64], nf: usize) -> Vec<f64> {
         let len = self.fft.spectrum_len();
         let zero = Complex64::new(0.0, 0.0);
-        let nf = if self.kernel_l.is_some() { 6 } else { 3 };
-        let grid = self.spread(nf, &|i, c| {
-            if c < 3 {
-                f[3 * i + c]
-            } else {
-                self.radii_sq[i] * f[3 * i + c - 3]
-            }
-        });
         let mut spec: Vec<Vec<Complex64>> = (0..nf)
             .map(|c| {
                 let mut s = vec![zero; len];
-                self.fft.forward(&grid, nf, c, &mut s);
+                self.fft.forward(grid, nf, c, &mut s);
                 s
             })
             .collect();
-        drop(grid);
         const CHUNK: usize = 4096;
-        match &self.kernel_l {
-            None => {
-                let [s0, s1, s2] = &mut spec[..] else { return };
+        // nf is 3 without and 6 with the Laplacian kernel (by construction)
+        match (&self.kernel_l, &mut spec[..]) {
+            (None, [s0, s1, s2]) => {
                 (
                     s0.par_chunks_mut(CHUNK),
                     s1.par_chunks_mut(CHUNK),
@@ -310,10 +423,7 @@ impl Wave {
                         }
                     });
             }
-            Some(kl) => {
-                let [s0, s1, s2, t0, t1, t2] = &mut spec[..] else {
-                    return;
-                };
+            (Some(kl), [s0, s1, s2, t0, t1, t2]) => {
                 (
                     (
                         s0.par_chunks_mut(CHUNK),
@@ -340,20 +450,13 @@ impl Wave {
                         }
                     });
             }
+            _ => {}
         }
         let m = self.fft.m;
         let mut field = vec![0.0; m * m * m * nf];
         for (c, s) in spec.iter_mut().enumerate() {
             self.fft.inverse(s, &mut field, nf, c);
         }
-        out.par_chunks_mut(3).enumerate().for_each(|(i, o)| {
-            let g = self.gather(&field, nf, i);
-            let a2 = self.radii_sq[i];
-            for k in 0..3 {
-                // second field group: (L̃∗f)/6, weighted by the target's a²
-                let extra = if nf == 6 { a2 * g[3 + k] } else { 0.0 };
-                o[k] += g[k] + extra;
-            }
-        });
+        field
     }
 }
