@@ -120,14 +120,13 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let mut state = world.query::<(Entity, &mut F)>();
             pool.install(|| {
                 let mut system =
                     bevy_ecs::system::SystemState::<Query<(Entity, &mut F)>>::new(&mut world);
-                let mut q = system.get_mut(&mut world);
-                write_dense((&entities, &slots), &values, &mut q, |c, v| c.0 = v);
+                let mut q = system.get_mut(&mut world).unwrap();
+                write_dense((&entities, &slots), &values, &mut q, |c: &mut F, v| c.0 = v);
             });
-            let got: Vec<DVec3> = state.iter(&world).map(|(_, f)| f.0).collect();
+            let got: Vec<DVec3> = world.query::<&F>().iter(&world).map(|f| f.0).collect();
             (got, entities, values)
         };
         let (one, entities, values) = run(1);
