@@ -152,6 +152,48 @@ fn bitwise_identical_for_one_and_two_threads() {
     }
 }
 
+/// The fixed step on the LAMMPS-mirror configuration (WCA core, dipoles cut at 4 sigma) with
+/// 1331 particles: enough for every parallel path of the step (cell binning, list checks,
+/// pair forces, drift, noise, update and the component passes split among the threads), each
+/// run on one thread and on two, and the two trajectories are bitwise the same.
+#[test]
+fn the_fixed_step_is_bitwise_identical_for_one_and_two_threads() {
+    let s = scene(&magsep::studies::bench_brownian::lammps_mirror_scene(11, 3).unwrap());
+    let run = |threads: usize, single: bool| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let options = RunOptions {
+                single_threaded: single,
+                ..Default::default()
+            };
+            let mut sim = Simulation::from_scene(&s, options).unwrap();
+            let start = positions(&mut sim);
+            for _ in 0..40 {
+                sim.step();
+            }
+            (start, positions(&mut sim))
+        })
+    };
+    let (start, a) = run(1, true);
+    let (_, b) = run(2, true);
+    let (_, c) = run(2, false);
+    assert_eq!(a.len(), 1331);
+    // the particles moved, and by the Brownian step's order (√(2e-4) σ per step, σ = 150 nm)
+    let moved = a.iter().zip(&start).filter(|(p, q)| p != q).count();
+    assert_eq!(moved, a.len());
+    let bits = |x: &[glam::DVec3]| -> Vec<[u64; 3]> {
+        x.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    };
+    assert!(bits(&a) == bits(&b), "1 vs 2 threads");
+    assert!(
+        bits(&a) == bits(&c),
+        "1 vs 2 threads, multi-threaded executor"
+    );
+}
+
 fn identical_for_one_and_two_threads(kind: &str) {
     let s = scene(&dense_scene(&format!(
         r#"{{ kind = "{kind}", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }}"#

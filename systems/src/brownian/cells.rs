@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// A fast hasher for integer cell keys (multiply-rotate; keys are not adversarial).
 #[derive(Default, Clone, Copy)]
@@ -38,6 +39,10 @@ type CellMap = HashMap<[i64; 3], (u32, u32), BuildHasherDefault<CellHasher>>;
 
 /// Largest cell coordinate (2^60): far from `i64` overflow when offsets are added.
 const KEY_LIMIT: f64 = (1u64 << 60) as f64;
+
+/// Fewest particles per task of the parallel binning passes (each particle's key is its own
+/// computation, so the split does not change the list).
+const PAR_MIN: usize = 1024;
 
 /// Largest dense grid, in cells per binned particle (sparser sets use the hash map).
 const DENSE_CELLS_PER_PARTICLE: usize = 8;
@@ -141,10 +146,12 @@ impl CellList {
             // counting sort into the grid (stable: particles by index within a cell)
             let n = (dims[0] * dims[1] * dims[2]) as usize;
             let flat = |k: [i64; 3]| ((k[2] * dims[1] + k[1]) * dims[0] + k[0]) as usize;
-            let keys: Vec<usize> = members
-                .iter()
-                .map(|&i| flat(list.key(positions[i as usize])))
-                .collect();
+            let key = |&i: &u32| flat(list.key(positions[i as usize]));
+            let keys: Vec<usize> = if members.len() < PAR_MIN {
+                members.iter().map(key).collect()
+            } else {
+                members.par_iter().with_min_len(PAR_MIN).map(key).collect()
+            };
             let mut starts = vec![0u32; n + 1];
             for &k in &keys {
                 starts[k + 1] += 1;
@@ -177,7 +184,16 @@ impl CellList {
             list.order = keyed.into_iter().map(|(_, i)| i).collect();
             list.index = Index::Sparse(map);
         }
-        list.sorted = list.order.iter().map(|&i| positions[i as usize]).collect();
+        let at = |&i: &u32| positions[i as usize];
+        list.sorted = if list.order.len() < PAR_MIN {
+            list.order.iter().map(at).collect()
+        } else {
+            list.order
+                .par_iter()
+                .with_min_len(PAR_MIN)
+                .map(at)
+                .collect()
+        };
         list
     }
 

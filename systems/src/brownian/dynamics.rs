@@ -6,6 +6,7 @@
 use glam::DVec3;
 use magsep_components::brownian::{CaptureEvent, MomentModel};
 use magsep_components::shape::Shape;
+use rayon::prelude::*;
 
 use crate::forces::{ExternalForces, ParticleState};
 
@@ -13,8 +14,8 @@ use super::contact::{remove_overlaps, swept_capture_cached};
 use super::fibre_flow::FibreFlow;
 use super::hydro::Mobility;
 use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
-use super::stepper::Dynamics;
 use super::stepper::multirate::LocalDynamics;
+use super::stepper::{Dynamics, PARTICLE_CHUNK};
 
 /// Hydrodynamic interactions among the free particles: the prepared mobility and the particle
 /// index of each of its rows.
@@ -23,6 +24,28 @@ pub struct HydroState {
     pub mobility: Mobility,
     /// Particle index of each mobility row.
     pub rows: Vec<usize>,
+}
+
+/// The liquid's velocity at `x` \[m/s\]: mean flow `flow` and, with a flow field `ff`, the
+/// fibres' perturbation.
+fn liquid_at(ff: Option<&FibreFlow>, flow: DVec3, x: DVec3) -> DVec3 {
+    match ff {
+        Some(ff) => ff.velocity(flow, x),
+        None => flow,
+    }
+}
+
+/// `f(i, &mut out[i])` for every particle, in parallel chunks of [`PARTICLE_CHUNK`] from two
+/// chunks on (every element is its own computation: bitwise the same for any thread count).
+fn per_particle(out: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync + Send) {
+    if out.len() < 2 * PARTICLE_CHUNK {
+        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
+    } else {
+        out.par_iter_mut()
+            .with_min_len(PARTICLE_CHUNK)
+            .enumerate()
+            .for_each(|(i, o)| f(i, o));
+    }
 }
 
 /// One step's view of the pipeline state as [`Dynamics`].
@@ -121,10 +144,7 @@ impl PipelineDynamics<'_> {
     /// The liquid's velocity at `x` \[m/s\]: the mean flow and, with a flow field, the
     /// fibres' perturbation.
     pub fn liquid(&self, x: DVec3) -> DVec3 {
-        match self.flow_field {
-            Some(ff) => ff.velocity(self.flow, x),
-            None => self.flow,
-        }
+        liquid_at(self.flow_field, self.flow, x)
     }
 
     /// Velocities at positions `x` from forces `f` (masked to the free particles), plus the
@@ -132,14 +152,16 @@ impl PipelineDynamics<'_> {
     pub fn velocities(&self, x: &[DVec3], f: &[DVec3], v: &mut [DVec3]) {
         match self.hydro {
             None => {
-                for i in 0..f.len() {
-                    v[i] = if self.mobile[i] {
-                        f[i] / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i])
-                            + self.liquid(x[i])
+                let (mobile, radii, eta) = (&self.mobile, self.radii, self.viscosity);
+                let (ff, flow) = (self.flow_field, self.flow);
+                per_particle(&mut v[..f.len()], |i, vi| {
+                    *vi = if mobile[i] {
+                        f[i] / (6.0 * std::f64::consts::PI * eta * radii[i])
+                            + liquid_at(ff, flow, x[i])
                     } else {
                         DVec3::ZERO
                     };
-                }
+                });
             }
             Some(h) => {
                 let fs: Vec<DVec3> = h.rows.iter().map(|&i| f[i]).collect();
@@ -198,15 +220,15 @@ impl Dynamics for PipelineDynamics<'_> {
     fn noise(&mut self, w: &[DVec3], out: &mut [DVec3]) {
         match self.hydro {
             None => {
-                for i in 0..w.len() {
-                    out[i] = if self.mobile[i] {
-                        let mu =
-                            1.0 / (6.0 * std::f64::consts::PI * self.viscosity * self.radii[i]);
-                        w[i] * (2.0 * self.kt * mu).sqrt()
+                let (mobile, radii, eta, kt) = (&self.mobile, self.radii, self.viscosity, self.kt);
+                per_particle(&mut out[..w.len()], |i, o| {
+                    *o = if mobile[i] {
+                        let mu = 1.0 / (6.0 * std::f64::consts::PI * eta * radii[i]);
+                        w[i] * (2.0 * kt * mu).sqrt()
                     } else {
                         DVec3::ZERO
                     };
-                }
+                });
             }
             Some(h) => {
                 let ws: Vec<DVec3> = h.rows.iter().map(|&i| w[i]).collect();

@@ -108,9 +108,15 @@ impl VerletList {
         let limit = 0.25 * self.skin * self.skin;
         // NaN displacements fail the test, so a broken configuration is rebinned (and its
         // non-finite particles dropped by the cell list)
-        x.iter()
-            .zip(&self.reference)
-            .all(|(p, q)| (*p - *q).length_squared() <= limit)
+        let within = |(p, q): (&DVec3, &DVec3)| (*p - *q).length_squared() <= limit;
+        if x.len() < 4 * CHUNK {
+            x.iter().zip(&self.reference).all(within)
+        } else {
+            x.par_iter()
+                .zip(self.reference.par_iter())
+                .with_min_len(4 * CHUNK)
+                .all(within)
+        }
     }
 
     /// Make the list serve `x` for pairs closer than `range` \[m\], rebuilding with `skin` \[m\]
