@@ -158,11 +158,7 @@ impl Background {
     /// Hand `call` to the writer thread; returns the thread's earlier error, if any.
     pub(super) fn send(&mut self, call: Call) -> Result<(), RecordError> {
         self.take_error()?;
-        let sent = match &self.sender {
-            Some(s) => s.send(Job::Call(call)).is_ok(),
-            None => false,
-        };
-        if sent {
+        if self.push(call) {
             return Ok(());
         }
         // the thread ended: it met an error (or the writer is finished)
@@ -170,6 +166,26 @@ impl Background {
         self.join_thread()?;
         self.take_error()?;
         Err(stopped(&self.path))
+    }
+
+    /// Hand a call that cannot fail to the writer thread; an error of the thread is left for
+    /// the next fallible call.
+    pub(super) fn send_unit(&mut self, call: impl FnOnce(&mut RecordingWriter) + Send + 'static) {
+        if !self.failed {
+            // not sent: the thread ended at an error, which stays for the next call
+            self.push(Box::new(move |w| {
+                call(w);
+                Ok(())
+            }));
+        }
+    }
+
+    /// Hand `call` to the writer thread; whether it is still there to take it.
+    fn push(&mut self, call: Call) -> bool {
+        match &self.sender {
+            Some(s) => s.send(Job::Call(call)).is_ok(),
+            None => false,
+        }
     }
 
     /// Make `call` on the writer thread and wait for its result (calls that return a value).

@@ -242,7 +242,7 @@ impl RecordingWriter {
     pub fn buffer_frames(&mut self, policy: Option<FrameBuffering>) {
         if let Some(bg) = &mut self.background {
             // an error of the writer thread is returned by the next fallible call
-            let _ = bg.send(Box::new(move |w| Ok(w.buffer_frames(policy))));
+            bg.send_unit(move |w| w.buffer_frames(policy));
             return;
         }
         self.buffering = policy;
@@ -394,7 +394,7 @@ impl RecordingWriter {
     /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
     pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
         if let Some(bg) = &mut self.background {
-            let _ = bg.send(Box::new(move |w| Ok(w.set_fibres(fibres))));
+            bg.send_unit(move |w| w.set_fibres(fibres));
             return;
         }
         self.drain_before_decor();
@@ -409,7 +409,7 @@ impl RecordingWriter {
     pub fn set_walls<W: serde::Serialize>(&mut self, walls: Option<W>) {
         if let Some(bg) = &mut self.background {
             let walls = walls.and_then(|w| WallShape::from_serialize(&w));
-            let _ = bg.send(Box::new(move |w| Ok(w.set_walls(walls))));
+            bg.send_unit(move |w| w.set_walls(walls));
             return;
         }
         self.drain_before_decor();
@@ -419,7 +419,7 @@ impl RecordingWriter {
     /// Boxes to draw behind the particles (entity `backdrop`) in every following scene update.
     pub fn set_backdrop(&mut self, cubes: Vec<BackdropCube>) {
         if let Some(bg) = &mut self.background {
-            let _ = bg.send(Box::new(move |w| Ok(w.set_backdrop(cubes))));
+            bg.send_unit(move |w| w.set_backdrop(cubes));
             return;
         }
         self.drain_before_decor();
@@ -431,7 +431,7 @@ impl RecordingWriter {
     /// particles are drawn as ellipsoids of these semi-axes.
     pub fn set_semi_axes(&mut self, semi_axes: Vec<DVec3>) {
         if let Some(bg) = &mut self.background {
-            let _ = bg.send(Box::new(move |w| Ok(w.set_semi_axes(semi_axes))));
+            bg.send_unit(move |w| w.set_semi_axes(semi_axes));
             return;
         }
         self.drain_before_decor();
@@ -455,6 +455,12 @@ impl RecordingWriter {
     /// a `serde_json::Value`, needs no check: a run's summary of a few thousand numbers took
     /// longer to parse again than to write).
     pub fn write_summary_value(&mut self, summary: &serde_json::Value) -> Result<(), RecordError> {
+        if let Some(bg) = &mut self.background {
+            // a copy is cheaper than its JSON text (formatting the numbers): leave that to
+            // the writer thread
+            let summary = summary.clone();
+            return bg.send(Box::new(move |w| w.write_summary_value(&summary)));
+        }
         let entries = BTreeMap::from([("summary".to_string(), summary.to_string())]);
         self.write_metadata(SUMMARY_METADATA_NAME, entries)
     }
