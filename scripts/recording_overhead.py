@@ -14,8 +14,9 @@ rounds of recorded / plain. The process's start (~5 ms) is in both runs. `magsep
 recording --json` measures the same inside one process, without the start; `valgrind
 --tool=callgrind` instruction counts of the two runs give a repeatable ratio under any load.
 
-Usage (from the repository root): scripts/recording_overhead.py [--rounds N] [CASE ...]
-with CASE among levitation, mds, brownian, packing (default: all). magsep is taken from
+Usage (from the repository root): scripts/recording_overhead.py [--rounds N] [--threads T]
+[CASE ...] with CASE among levitation, mds, brownian, packing (default: all) and T the
+`--threads` of the runs (default 1; `default`: no `--threads`, the machine's cores). magsep is taken from
 $MAGSEP (default target/release/magsep). Exit code 1 if a run fails.
 """
 
@@ -60,13 +61,18 @@ def main(argv):
         i = argv.index("--rounds")
         rounds = int(argv[i + 1])
         del argv[i : i + 2]
+    threads = ["--threads", "1"]
+    if "--threads" in argv:
+        i = argv.index("--threads")
+        threads = [] if argv[i + 1] == "default" else ["--threads", argv[i + 1]]
+        del argv[i : i + 2]
     cases = argv or list(CASES)
     magsep = os.environ.get("MAGSEP", "target/release/magsep")
     out = os.path.join(tempfile.gettempdir(), f"magsep-recording-overhead-{os.getpid()}.mcap")
     for case in cases:
         if case not in CASES:
             sys.exit(f"unknown case {case!r}; expected one of {', '.join(CASES)}")
-        plain_cmd = [magsep, "run", "--quiet", "--threads", "1", *CASES[case]]
+        plain_cmd = [magsep, "run", "--quiet", *threads, *CASES[case]]
         rec_cmd = plain_cmd + ["--force", "--record", out]
         plain, rec = [], []
         for r in range(rounds):
@@ -88,7 +94,11 @@ def main(argv):
                     "cpu_ratio": statistics.median(cpu),
                     "cpu_ratio_min": min(cpu),
                     "cpu_ratio_max": max(cpu),
+                    "wall_plain_s": statistics.median(a[1] for a in plain),
+                    "wall_recorded_s": statistics.median(b[1] for b in rec),
                     "wall_ratio": statistics.median(wall),
+                    "wall_ratio_min": min(wall),
+                    "wall_ratio_max": max(wall),
                     "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(
                         timespec="seconds"
                     ),

@@ -346,7 +346,8 @@ fn open_recording(
             .collect(),
         extra: overrides_metadata(&scene.overrides),
     };
-    let mut writer = RecordingWriter::create(path, &meta)?;
+    // the header, encoding, compression and writes run on a writer thread of their own
+    let mut writer = RecordingWriter::create_background(path, &meta)?;
     if !scene.record.as_ref().is_some_and(|r| r.flush_every_frame) {
         writer.buffer_frames(Some(FrameBuffering::default()));
     }

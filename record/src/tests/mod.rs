@@ -1,5 +1,6 @@
 //! Tests of the recording format: round trips, truncation, corruption, interoperability.
 
+mod background;
 mod buffering;
 mod channels;
 mod damage;

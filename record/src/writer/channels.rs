@@ -55,6 +55,12 @@ impl RecordingWriter {
                 detail: format!("topic {topic:?} is empty or already has a channel"),
             });
         }
+        if let Some(bg) = &mut self.background {
+            let (topic, name) = (topic.to_string(), schema_name.to_string());
+            let (encoding, data) = (schema_encoding.to_string(), schema_data.to_vec());
+            let message = message_encoding.to_string();
+            return bg.call(move |w| w.add_channel(&topic, &name, &encoding, &data, &message));
+        }
         self.drain_queue()?;
         let schema_id = if schema_encoding.is_empty() && schema_data.is_empty() {
             0
@@ -113,6 +119,13 @@ impl RecordingWriter {
         &mut self,
         messages: &[(ChannelHandle, u64, &[u8])],
     ) -> Result<(), RecordError> {
+        if let Some(bg) = &mut self.background {
+            let owned: Vec<_> = messages.iter().map(|m| (m.0, m.1, m.2.to_vec())).collect();
+            return bg.send(Box::new(move |w| {
+                let borrowed: Vec<_> = owned.iter().map(|m| (m.0, m.1, &m.2[..])).collect();
+                w.write_messages(&borrowed)
+            }));
+        }
         for (channel, _, _) in messages {
             if self.channels.get(channel.index).map(|c| c.id) != Some(channel.id) {
                 return Err(RecordError::InvalidInput {

@@ -1,8 +1,12 @@
 //! [`RecordingWriter`]: writes a run to an MCAP file, frame by frame, and the channels and
 //! metadata records that plugins add.
 
+mod background;
 mod channels;
 mod queue;
+
+pub use background::BACKGROUND_CALLS;
+pub use queue::FrameBuffering;
 
 pub use channels::ChannelHandle;
 
@@ -15,6 +19,7 @@ use crate::{
     INTERRUPTED_METADATA_NAME, METADATA_NAME, ParticleFrame, RecordError, RecordingMetadata,
     SCENE_TOPIC, STATE_TOPIC, SUMMARY_METADATA_NAME,
 };
+use background::Background;
 use channels::AddedChannel;
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
@@ -26,7 +31,7 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Where a recording's bytes go: a [`File`], or any seekable sink (an in-memory buffer, or in
 /// tests one that fails like a full disk), see [`RecordingWriter::from_sink`].
@@ -129,25 +134,9 @@ pub struct RecordingWriter {
     /// An error met while encoding queued frames in a call that cannot return it (the
     /// `set_*` methods); the next fallible call returns it.
     deferred_error: Option<RecordError>,
-}
-
-/// How long frames may wait in the open chunk (see [`RecordingWriter::buffer_frames`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameBuffering {
-    /// Flush once the open chunk holds this many message bytes (uncompressed).
-    pub max_bytes: u64,
-    /// Flush at the first frame written this long after the last flush.
-    pub max_wait: Duration,
-}
-
-impl Default for FrameBuffering {
-    /// 1 MiB or 1 s, whichever comes first.
-    fn default() -> Self {
-        Self {
-            max_bytes: 1 << 20,
-            max_wait: Duration::from_secs(1),
-        }
-    }
+    /// The writer thread of [`create_background`](Self::create_background), which makes
+    /// every call on a plain writer of its own; `None`: calls are made here.
+    background: Option<Background>,
 }
 
 impl RecordingWriter {
@@ -182,27 +171,7 @@ impl RecordingWriter {
             // frame ~100 µs of thread wake-ups, more than the compression itself.
             .compression_threads(0)
             .compression_level(COMPRESSION_LEVEL);
-        let mut writer = Self {
-            mcap: None,
-            path: path.to_path_buf(),
-            state_channel: 0,
-            scene_channel: 0,
-            frames_written: 0,
-            last_log_time: None,
-            buf: Vec::new(),
-            scene_buf: Vec::new(),
-            decor: SceneDecor::default(),
-            scene_cache: SceneCache::default(),
-            channels: Vec::new(),
-            max_chunk: MAX_CHUNK_BYTES,
-            buffering: None,
-            pending: 0,
-            last_flush: Instant::now(),
-            last_frame: None,
-            queued: Vec::new(),
-            queued_particles: 0,
-            deferred_error: None,
-        };
+        let mut writer = Self::unopened(path);
         let mut mcap = options
             .create(BufWriter::new(sink))
             .map_err(|e| writer.write_error(e))?;
@@ -233,6 +202,32 @@ impl RecordingWriter {
         Ok(writer)
     }
 
+    /// A writer of `path` with no MCAP writer yet (nothing open, nothing written).
+    fn unopened(path: &Path) -> Self {
+        Self {
+            mcap: None,
+            path: path.to_path_buf(),
+            state_channel: 0,
+            scene_channel: 0,
+            frames_written: 0,
+            last_log_time: None,
+            buf: Vec::new(),
+            scene_buf: Vec::new(),
+            decor: SceneDecor::default(),
+            scene_cache: SceneCache::default(),
+            channels: Vec::new(),
+            max_chunk: MAX_CHUNK_BYTES,
+            buffering: None,
+            pending: 0,
+            last_flush: Instant::now(),
+            last_frame: None,
+            queued: Vec::new(),
+            queued_particles: 0,
+            deferred_error: None,
+            background: None,
+        }
+    }
+
     /// Let frames that arrive fast share chunks: [`write_frame`](Self::write_frame) then ends
     /// the chunk (one zstd frame and one write to the file) only once `policy.max_bytes` of
     /// messages are pending, `policy.max_wait` has passed since the last flush, or the frame
@@ -245,6 +240,11 @@ impl RecordingWriter {
     /// `writer/queue.rs`; the file's bytes do not change), so an encoding error can be returned
     /// by a later call than the frame's. `None` restores one chunk per frame (the default).
     pub fn buffer_frames(&mut self, policy: Option<FrameBuffering>) {
+        if let Some(bg) = &mut self.background {
+            // an error of the writer thread is returned by the next fallible call
+            bg.send_unit(move |w| w.buffer_frames(policy));
+            return;
+        }
         self.buffering = policy;
     }
 
@@ -302,6 +302,11 @@ impl RecordingWriter {
                     c.len()
                 ),
             });
+        }
+        if let Some(bg) = &mut self.background {
+            self.frames_written += 1;
+            let (frame, colours) = (frame.into_owned(), colours.map(Cow::into_owned));
+            return bg.send(Box::new(move |w| w.write_frame_owned(frame, colours)));
         }
         if let Some(e) = self.deferred_error.take() {
             return Err(e);
@@ -388,6 +393,10 @@ impl RecordingWriter {
 
     /// Fibres to draw (as cylinders, entity `fibres`) in every following scene update.
     pub fn set_fibres(&mut self, fibres: Vec<FibreShape>) {
+        if let Some(bg) = &mut self.background {
+            bg.send_unit(move |w| w.set_fibres(fibres));
+            return;
+        }
         self.drain_before_decor();
         self.decor.fibres = fibres;
         self.scene_cache.clear_statics();
@@ -398,12 +407,21 @@ impl RecordingWriter {
     /// `magsep_components::container::Walls`, whose serde form is the same; this keeps the codec
     /// free of ECS types). A value of another form draws no walls.
     pub fn set_walls<W: serde::Serialize>(&mut self, walls: Option<W>) {
+        if let Some(bg) = &mut self.background {
+            let walls = walls.and_then(|w| WallShape::from_serialize(&w));
+            bg.send_unit(move |w| w.set_walls(walls));
+            return;
+        }
         self.drain_before_decor();
         self.decor.walls = walls.and_then(|w| WallShape::from_serialize(&w));
     }
 
     /// Boxes to draw behind the particles (entity `backdrop`) in every following scene update.
     pub fn set_backdrop(&mut self, cubes: Vec<BackdropCube>) {
+        if let Some(bg) = &mut self.background {
+            bg.send_unit(move |w| w.set_backdrop(cubes));
+            return;
+        }
         self.drain_before_decor();
         self.decor.backdrop = cubes;
         self.scene_cache.clear_statics();
@@ -412,6 +430,10 @@ impl RecordingWriter {
     /// Superquadric semi-axes per particle (frame order; zero for spheres and rods): such
     /// particles are drawn as ellipsoids of these semi-axes.
     pub fn set_semi_axes(&mut self, semi_axes: Vec<DVec3>) {
+        if let Some(bg) = &mut self.background {
+            bg.send_unit(move |w| w.set_semi_axes(semi_axes));
+            return;
+        }
         self.drain_before_decor();
         self.decor.semi_axes = semi_axes;
     }
@@ -433,6 +455,12 @@ impl RecordingWriter {
     /// a `serde_json::Value`, needs no check: a run's summary of a few thousand numbers took
     /// longer to parse again than to write).
     pub fn write_summary_value(&mut self, summary: &serde_json::Value) -> Result<(), RecordError> {
+        if let Some(bg) = &mut self.background {
+            // a copy is cheaper than its JSON text (formatting the numbers): leave that to
+            // the writer thread
+            let summary = summary.clone();
+            return bg.send(Box::new(move |w| w.write_summary_value(&summary)));
+        }
         let entries = BTreeMap::from([("summary".to_string(), summary.to_string())]);
         self.write_metadata(SUMMARY_METADATA_NAME, entries)
     }
@@ -459,6 +487,9 @@ impl RecordingWriter {
     }
 
     fn finish_inner(mut self, sync: bool) -> Result<(), RecordError> {
+        if let Some(mut bg) = self.background.take() {
+            return bg.finish(sync);
+        }
         self.drain_queue()?;
         let Some(mut mcap) = self.mcap.take() else {
             return Ok(());
@@ -499,6 +530,10 @@ impl RecordingWriter {
         name: &str,
         entries: BTreeMap<String, String>,
     ) -> Result<(), RecordError> {
+        if let Some(bg) = &mut self.background {
+            let name = name.to_string();
+            return bg.send(Box::new(move |w| w.write_metadata(&name, entries)));
+        }
         self.drain_queue()?;
         let metadata = Metadata {
             name: name.into(),

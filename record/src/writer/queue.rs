@@ -12,6 +12,25 @@ use super::RecordingWriter;
 use crate::{ParticleFrame, RecordError};
 use std::time::{Duration, Instant};
 
+/// How long frames may wait in the open chunk (see [`RecordingWriter::buffer_frames`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameBuffering {
+    /// Flush once the open chunk holds this many message bytes (uncompressed).
+    pub max_bytes: u64,
+    /// Flush at the first frame written this long after the last flush.
+    pub max_wait: Duration,
+}
+
+impl Default for FrameBuffering {
+    /// 1 MiB or 1 s, whichever comes first.
+    fn default() -> Self {
+        Self {
+            max_bytes: 1 << 20,
+            max_wait: Duration::from_secs(1),
+        }
+    }
+}
+
 /// Most frames queued before they are encoded.
 pub const QUEUE_FRAMES: usize = 64;
 /// Most particles queued before the frames are encoded; larger frames are never queued
