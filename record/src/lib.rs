@@ -85,6 +85,7 @@ mod proto;
 pub mod reader;
 mod scene;
 pub mod schema;
+pub mod testing;
 pub mod writer;
 
 #[cfg(test)]

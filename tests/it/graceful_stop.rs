@@ -3,14 +3,15 @@
 //! brownian ensemble), and a recording write failure (a sink that fails like a full disk)
 //! stops the run at that very step with the summary of what ran.
 
-use std::io::{Cursor, Seek, SeekFrom, Write};
+use magsep::plugins::record::testing::FullDisk;
+use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use magsep::bevy_ecs::world::World;
 use magsep::plugins::record::{
-    INTERRUPTED_METADATA_NAME, RecordingMetadata, RecordingSink, RecordingWriter, read_recording,
+    INTERRUPTED_METADATA_NAME, RecordingMetadata, RecordingWriter, read_recording,
     read_recording_bytes,
 };
 use magsep::plugins::recorder::Recorder;
@@ -159,34 +160,6 @@ fn a_stop_during_an_ensemble_stops_every_replicate() {
     let recorded: Value = serde_json::from_str(rec.summary_json.as_deref().unwrap()).unwrap();
     assert_eq!(recorded["interrupted_by"], "timer");
 }
-
-/// A sink that accepts `limit` bytes, then fails like a full disk (ENOSPC).
-struct FullDisk {
-    data: Arc<Mutex<Cursor<Vec<u8>>>>,
-    limit: u64,
-}
-
-impl Write for FullDisk {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let mut c = self.data.lock().unwrap();
-        let room = self.limit.saturating_sub(c.position()) as usize;
-        if room == 0 && !buf.is_empty() {
-            return Err(std::io::Error::from_raw_os_error(28));
-        }
-        c.write(&buf[..buf.len().min(room)])
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
-impl Seek for FullDisk {
-    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
-        self.data.lock().unwrap().seek(pos)
-    }
-}
-
-impl RecordingSink for FullDisk {}
 
 #[test]
 fn a_write_failure_stops_the_run_at_that_step_and_keeps_what_was_written_readable() {

@@ -1,7 +1,8 @@
 //! The background writer ([`RecordingWriter::create_background`]): the same file as a plain
 //! writer given the same calls; errors of its thread returned by a later call, never a panic.
 
-use std::io::{Cursor, Seek, SeekFrom, Write};
+use crate::testing::FullDisk;
+use std::io::Cursor;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -9,8 +10,7 @@ use std::time::Duration;
 use super::{TempFile, assert_frames_bitwise_eq, metadata, random_frames};
 use crate::frame::FibreShape;
 use crate::{
-    FrameBuffering, RecordingMetadata, RecordingSink, RecordingWriter, read_recording,
-    read_recording_bytes,
+    FrameBuffering, RecordingMetadata, RecordingWriter, read_recording, read_recording_bytes,
 };
 use glam::DVec3;
 
@@ -104,34 +104,6 @@ fn a_background_writer_cannot_create_a_file_in_a_missing_directory() {
     .unwrap_err();
     assert!(err.to_string().contains("/nonexistent-dir/x.mcap"), "{err}");
 }
-
-/// A sink that accepts `limit` bytes, then fails like a full disk (ENOSPC).
-struct FullDisk {
-    data: Arc<Mutex<Cursor<Vec<u8>>>>,
-    limit: u64,
-}
-
-impl Write for FullDisk {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let mut c = self.data.lock().unwrap();
-        let room = self.limit.saturating_sub(c.position()) as usize;
-        if room == 0 && !buf.is_empty() {
-            return Err(std::io::Error::from_raw_os_error(28));
-        }
-        c.write(&buf[..buf.len().min(room)])
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
-impl Seek for FullDisk {
-    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
-        self.data.lock().unwrap().seek(pos)
-    }
-}
-
-impl RecordingSink for FullDisk {}
 
 #[test]
 fn a_full_disk_is_reported_by_a_later_call_and_what_was_written_stays_readable() {
