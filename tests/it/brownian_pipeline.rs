@@ -152,6 +152,15 @@ fn bitwise_identical_for_one_and_two_threads() {
     }
 }
 
+/// `f` on a rayon pool of `threads` threads.
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(f)
+}
+
 /// The fixed step on the LAMMPS-mirror configuration (WCA core, dipoles cut at 4 sigma) with
 /// 1331 particles: enough for every parallel path of the step (cell binning, list checks,
 /// pair forces, drift, noise, update and the component passes split among the threads), each
@@ -160,11 +169,7 @@ fn bitwise_identical_for_one_and_two_threads() {
 fn the_fixed_step_is_bitwise_identical_for_one_and_two_threads() {
     let s = scene(&magsep::studies::bench_brownian::lammps_mirror_scene(11, 3).unwrap());
     let run = |threads: usize, single: bool| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let options = RunOptions {
                 single_threaded: single,
                 ..Default::default()
@@ -199,11 +204,7 @@ fn identical_for_one_and_two_threads(kind: &str) {
         r#"{{ kind = "{kind}", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }}"#
     )));
     let run = |threads: usize, single: bool| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut sim = Simulation::from_scene(
                 &s,
                 RunOptions {
