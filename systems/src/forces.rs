@@ -12,7 +12,6 @@
 use bevy_ecs::prelude::*;
 use magsep_components::forces::{ForceContribution, NetForce, NetTorque};
 
-use crate::par::{PAR_MIN_ENTITIES, rayon_batching};
 use crate::sets::SimSystems;
 
 pub mod kernel;
@@ -20,40 +19,31 @@ pub use kernel::{
     Consumption, ExternalForce, ExternalForces, ForceUse, ParticleState, compute_kernel_forces,
 };
 
-/// Zero `NetForce` and `NetTorque` (first system of `Accumulate`). Every pass here writes
-/// only the entity it visits, so it splits among the rayon pool's threads
-/// ([`rayon_batching`]) with bitwise the same result.
+/// Zero `NetForce` and `NetTorque` (first system of `Accumulate`).
+///
+/// The passes here are plain loops on the system's thread: they move a few bytes per
+/// particle, and splitting them among threads cost more than it saved (the 2-thread rate of
+/// the LAMMPS-mirror Brownian bench rose from 2.33 M to 2.74 M particle-steps/s, mean of four
+/// interleaved rounds, when they went back to one thread).
 pub fn clear_net_force(mut q: Query<(&mut NetForce, &mut NetTorque)>) {
-    let clear = |(mut f, mut t): (Mut<NetForce>, Mut<NetTorque>)| {
+    for (mut f, mut t) in &mut q {
         f.0 = glam::DVec3::ZERO;
         t.0 = glam::DVec3::ZERO;
-    };
-    match rayon_batching(q.iter().len(), PAR_MIN_ENTITIES) {
-        Some(b) => q.par_iter_mut().batching_strategy(b).for_each(clear),
-        None => q.iter_mut().for_each(clear),
     }
 }
 
 /// Reset contribution `T` on every entity (runs in `Prepare`).
 pub fn clear_contribution<T: ForceContribution>(mut q: Query<&mut T>) {
-    match rayon_batching(q.iter().len(), PAR_MIN_ENTITIES) {
-        Some(b) => q
-            .par_iter_mut()
-            .batching_strategy(b)
-            .for_each(|mut c| c.clear()),
-        None => q.iter_mut().for_each(|mut c| c.clear()),
+    for mut c in &mut q {
+        c.clear();
     }
 }
 
 /// Add contribution `T` into `NetForce`/`NetTorque` (runs in `Accumulate`).
 pub fn add_contribution<T: ForceContribution>(mut q: Query<(&T, &mut NetForce, &mut NetTorque)>) {
-    let add = |(c, mut f, mut t): (&T, Mut<NetForce>, Mut<NetTorque>)| {
+    for (c, mut f, mut t) in &mut q {
         f.0 += c.force();
         t.0 += c.torque();
-    };
-    match rayon_batching(q.iter().len(), PAR_MIN_ENTITIES) {
-        Some(b) => q.par_iter_mut().batching_strategy(b).for_each(add),
-        None => q.iter_mut().for_each(add),
     }
 }
 

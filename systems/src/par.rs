@@ -17,27 +17,6 @@ pub fn worth_parallel(upper: Option<usize>, min: usize) -> bool {
     upper.is_none_or(|n| n >= min)
 }
 
-/// The batching of a per-entity pass over `n` entities split into one batch per thread of the
-/// current rayon pool: `Some` when that pool has several threads, `n >= min` and bevy's compute
-/// pool exists, `None` (run the pass in place) otherwise. Pipelines whose numerical kernels run
-/// on a rayon pool use it for their component passes, so that a one-thread pool stays one
-/// thread and a k-thread pool runs at most k batches at once (on bevy's compute pool, the
-/// query's own parallel iterator).
-///
-/// ```
-/// bevy_tasks::ComputeTaskPool::get_or_init(bevy_tasks::TaskPool::default);
-/// let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-/// assert!(one.install(|| magsep_systems::par::rayon_batching(10_000, 256)).is_none());
-/// let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-/// assert!(two.install(|| magsep_systems::par::rayon_batching(10_000, 256)).is_some());
-/// assert!(two.install(|| magsep_systems::par::rayon_batching(100, 256)).is_none());
-/// ```
-pub fn rayon_batching(n: usize, min: usize) -> Option<bevy_ecs::batching::BatchingStrategy> {
-    let threads = rayon::current_num_threads();
-    (threads > 1 && n >= min.max(1) && bevy_tasks::ComputeTaskPool::try_get().is_some())
-        .then(|| bevy_ecs::batching::BatchingStrategy::fixed(n.div_ceil(threads)))
-}
-
 /// `query.par_iter_mut().for_each(body)`, or the same body in a plain loop when the query
 /// matches fewer than `min` entities (default [`PAR_MIN_ENTITIES`]). The body must only touch
 /// the entity it is given (as `par_iter_mut` requires anyway).

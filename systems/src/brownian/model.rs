@@ -81,6 +81,8 @@ pub struct PairLists {
     /// Per particle, a lower bound of its gap to the fibres where it last moved (the capture
     /// search's memo, see [`swept_capture_cached`](super::contact::swept_capture_cached)).
     pub capture_gaps: Vec<Option<super::contact::GapBound>>,
+    /// The per-pair buffer of the dipole sum, kept across evaluations.
+    pub pair_scratch: super::verlet::PairScratch,
 }
 
 impl PairLists {
@@ -283,7 +285,8 @@ impl ForceModel {
         // each pair once (the force on its lower index), into its slot; chunks of particles
         // own consecutive slot ranges
         let n = x.len();
-        let mut pf = vec![DVec3::ZERO; list.pair_count()];
+        // every slot is written below before it is read
+        let mut pf = lists.pair_scratch.take(list.pair_count());
         let mut parts: Vec<(usize, &mut [DVec3])> = Vec::with_capacity(n.div_ceil(PAIR_CHUNK));
         let mut rest = pf.as_mut_slice();
         for c in 0..n.div_ceil(PAIR_CHUNK) {
@@ -322,6 +325,7 @@ impl ForceModel {
             }
             *f = sum;
         });
+        lists.pair_scratch.put(pf);
     }
 
     /// [`ForceModel::dipole_forces`] computed per particle over every neighbour, each pair
@@ -487,7 +491,10 @@ mod tests {
         };
         // captured particles that keep interacting, and ones that do not
         let mobile: Vec<bool> = (0..n).map(|i| i % 7 != 2).collect();
-        for interact in [true, false] {
+        // one `PairLists` for all three passes: the per-pair buffer is reused with another
+        // pair count each time (fewer pairs without the captured ones, then more again)
+        let mut lists = PairLists::default();
+        for interact in [true, false, true] {
             let exerts: Vec<bool> = mobile.iter().map(|&m| m || interact).collect();
             let view = ParticleView {
                 radii: &radii,
@@ -495,7 +502,6 @@ mod tests {
                 mobile: &mobile,
                 exerts: &exerts,
             };
-            let mut lists = PairLists::default();
             model.update_lists(&x, &view, &mut lists);
             assert!(lists.dipole.pair_count() > 10 * n, "dense enough to test");
             let (mut fast, mut direct) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);

@@ -13,11 +13,10 @@
 //! | `Finalize::WriteBack` | [`write_back_brownian`] | `BrownianWorkspace` | `Position`, `Captured`, `ParticleRng` |
 //! | `Observe` | [`observe_capture`] | `BrownianWorkspace` | `CaptureCurve` |
 //!
-//! **Threads.** The component passes (writing the forces, reading `NetForce` back, the
-//! write-back) visit every particle once per step. On a rayon pool of k > 1 threads they split
-//! into k batches of the query ([`crate::par::rayon_batching`]; each entity finds its workspace
-//! index through [`BrownianWorkspace::slot`]), on one thread they run in place; every entity's
-//! write is its own, so the trajectory is bitwise the same for any thread count (tested in
+//! **Threads.** The numerical kernels run on the rayon pool; the component passes (writing the
+//! forces, reading `NetForce` back, the write-back) run on the system's thread
+//! ([`super::passes`] says why). Every kernel writes each particle's own value, so the
+//! trajectory is bitwise the same for any thread count (tested in
 //! `tests/it/brownian_pipeline.rs`).
 
 use bevy_ecs::prelude::*;
@@ -34,9 +33,8 @@ use super::stepper::advance;
 use super::stepper::multirate::advance_multirate;
 use crate::field::CylinderSource;
 use crate::forces::ExternalForces;
-use crate::par::{PAR_MIN_ENTITIES, rayon_batching};
 
-use super::passes::{Gathered, in_workspace_order, slot_in, slots_of, write_dense};
+use super::passes::{in_workspace_order, write_dense};
 use magsep_components::forces::KernelForce;
 
 /// Dense state of the run in `ParticleId` order (a resource; authoritative during a run, copied
@@ -73,9 +71,6 @@ pub struct BrownianWorkspace {
     pub method: MobilityMethod,
     /// The liquid's flow around the fibres (`BrownianConfig::flow_around_fibres` with a flow).
     pub flow_field: Option<FibreFlow>,
-    /// Workspace index of each entity, by entity index (`u32::MAX`: not in the workspace),
-    /// for the parallel component passes ([`BrownianWorkspace::slot`]).
-    pub slots: Vec<u32>,
 }
 
 impl BrownianWorkspace {
@@ -90,12 +85,6 @@ impl BrownianWorkspace {
             .iter()
             .map(|c| c.is_none() || config.captured_interact)
             .collect()
-    }
-
-    /// Workspace index of entity `e` (None when it is not one of [`BrownianWorkspace::entities`]).
-    #[inline]
-    pub fn slot(&self, e: Entity) -> Option<usize> {
-        slot_in(&self.entities, &self.slots, e)
     }
 
     /// Number of captured particles.
@@ -204,7 +193,6 @@ pub fn init_brownian_workspace(world: &mut World) {
     world.insert_resource(stats);
     let entities: Vec<Entity> = rows.iter().map(|r| r.1).collect();
     world.insert_resource(BrownianWorkspace {
-        slots: slots_of(&entities),
         entities,
         ids: rows.iter().map(|r| r.0.0).collect(),
         shapes: rows.iter().map(|r| r.7).collect(),
@@ -279,15 +267,8 @@ pub fn compute_field_forces(
     mut forces: Query<(Entity, &mut FieldForce)>,
     mut moments: Query<(Entity, &mut MagneticMoment)>,
 ) {
-    write_dense((&ws.entities, &ws.slots), &ws.field, &mut forces, |c, v| {
-        c.0 = v
-    });
-    write_dense(
-        (&ws.entities, &ws.slots),
-        &ws.moments,
-        &mut moments,
-        |c, v| c.0 = v,
-    );
+    write_dense(&ws.entities, &ws.field, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws.entities, &ws.moments, &mut moments, |c, v| c.0 = v);
 }
 
 /// Evaluate one pair-force kernel over the workspace into `out` (a dense array).
@@ -318,7 +299,7 @@ pub fn compute_dipole_forces(
         ws.model
             .dipole_forces(&ws.positions, &ws.moments, view, &ws.lists, out)
     });
-    write_dense((&ws.entities, &ws.slots), &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws.entities, &f, &mut forces, |c, v| c.0 = v);
 }
 
 /// Mie contact forces.
@@ -330,7 +311,7 @@ pub fn compute_contact_forces(
     let f = pair_forces(&ws, &config, |view, out| {
         ws.model.contact_forces(&ws.positions, view, &ws.lists, out)
     });
-    write_dense((&ws.entities, &ws.slots), &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws.entities, &f, &mut forces, |c, v| c.0 = v);
 }
 
 /// Build this step's mobility over the free particles (nothing for free draining).
@@ -399,35 +380,12 @@ pub fn integrate_brownian(
             + kf.map(|v| v.force).unwrap_or_default();
         (f.0, f.0 - model)
     };
-    if let Some(b) = rayon_batching(n, PAR_MIN_ENTITIES) {
-        // each batch of the query gathers its rows, placed once all batches are done
-        let batches = std::sync::Mutex::new(Vec::new());
-        let ws_ref = &*ws;
-        forces.par_iter().batching_strategy(b).for_each_init(
-            || Gathered {
-                rows: Vec::new(),
-                into: &batches,
-            },
-            |g, (e, row)| {
-                if let Some(k) = ws_ref.slot(e) {
-                    let (f, x) = parts(row);
-                    g.rows.push((k, f, x));
-                }
-            },
-        );
-        for rows in batches.into_inner().unwrap_or_default() {
-            for (k, f, x) in rows {
-                (net[k], extra[k]) = (f, x);
-            }
-        }
-    } else {
-        let mut split = |k: usize, row: ForceRow| (net[k], extra[k]) = parts(row);
-        // a linear pass while the query follows the workspace order, lookups for the rest
-        let k = in_workspace_order(&ws.entities, forces.iter(), &mut split);
-        for (k, e) in ws.entities.iter().enumerate().skip(k) {
-            if let Ok((_, row)) = forces.get(*e) {
-                split(k, row);
-            }
+    let mut split = |k: usize, row: ForceRow| (net[k], extra[k]) = parts(row);
+    // a linear pass while the query follows the workspace order, lookups for the rest
+    let k = in_workspace_order(&ws.entities, forces.iter(), &mut split);
+    for (k, e) in ws.entities.iter().enumerate().skip(k) {
+        if let Ok((_, row)) = forces.get(*e) {
+            split(k, row);
         }
     }
     let mut dynamics = PipelineDynamics {
@@ -522,21 +480,6 @@ pub fn write_back_brownian(
             }
             r.0.clone_from(&ws.rngs[k]);
         };
-    if let Some(b) = rayon_batching(ws.entities.len(), PAR_MIN_ENTITIES) {
-        let ws = &*ws;
-        q.par_iter_mut()
-            .batching_strategy(b)
-            .for_each(|(e, mut p, c, mut r)| {
-                if let Some(k) = ws.slot(e) {
-                    p.0 = ws.positions[k];
-                    if let Some(mut c) = c {
-                        c.0 = ws.captured[k];
-                    }
-                    r.0.clone_from(&ws.rngs[k]);
-                }
-            });
-        return;
-    }
     // a linear pass while the query follows the workspace order, lookups for the rest
     let k = in_workspace_order(
         &ws.entities,

@@ -83,6 +83,39 @@ pub struct VerletList {
     spare: Option<Box<VerletList>>,
 }
 
+/// A buffer reused across evaluations through a shared reference: the dipole sum's per-pair
+/// forces take a few MB at N = 10⁴ (about 14 pairs per particle). Allocated afresh at every
+/// evaluation, the allocator handed it back to the system each time and every step paid
+/// page faults and page clearing for it. A clone starts empty.
+#[derive(Debug, Default)]
+pub struct PairScratch(std::sync::Mutex<Vec<DVec3>>);
+
+impl Clone for PairScratch {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl PairScratch {
+    /// The buffer, resized to `len` (its old values are kept; new entries are zero).
+    pub fn take(&self, len: usize) -> Vec<DVec3> {
+        let mut v = self
+            .0
+            .lock()
+            .map(|mut g| std::mem::take(&mut *g))
+            .unwrap_or_default();
+        v.resize(len, DVec3::ZERO);
+        v
+    }
+
+    /// Give the buffer back for the next evaluation.
+    pub fn put(&self, v: Vec<DVec3>) {
+        if let Ok(mut g) = self.0.lock() {
+            *g = v;
+        }
+    }
+}
+
 impl VerletList {
     /// Number of builds so far.
     pub fn builds(&self) -> u64 {
