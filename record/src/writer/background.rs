@@ -1,6 +1,7 @@
 //! A recording written on a thread of its own ([`RecordingWriter::create_background`]): the
 //! calling thread (the simulation's) only hands each call, with the data it needs (a frame
-//! moves, a message is copied), to a bounded channel; a writer thread makes the calls on a
+//! moves, a message is copied), to a bounded queue that wakes the writer thread only now and
+//! then (`writer/mailbox.rs`); a writer thread makes the calls on a
 //! plain [`RecordingWriter`] in the same order, so the file's records are the same. The
 //! writer thread does the MCAP header, schemas and metadata record, the encoding, the zstd
 //! compression and the writes, and the summary section at the end. On two or more cores the
@@ -10,13 +11,14 @@
 //! writer, which closes the file best-effort, so what was written stays readable); the next
 //! call returns it (the same error as a plain writer's call would have returned, one call
 //! later), and every call after that an error saying the recording stopped. Memory is bounded:
-//! at most [`BACKGROUND_CALLS`] calls wait in the channel, the caller blocks when it is full.
+//! at most [`BACKGROUND_CALLS`] calls wait in the queue, the caller blocks when it is full.
 
+use super::mailbox::{Receiver, Sender, mailbox};
 use super::{RecordingSink, RecordingWriter};
 use crate::{RecordError, RecordingMetadata};
 use std::fs::File;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::mpsc::sync_channel;
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
@@ -37,7 +39,7 @@ enum Job {
 /// The caller's side of a background writer.
 pub(super) struct Background {
     /// `None` once finished (or dropped).
-    sender: Option<SyncSender<Job>>,
+    sender: Option<Sender<Job>>,
     thread: Option<JoinHandle<Result<(), RecordError>>>,
     /// The writer thread's first error, until a call returns it.
     error: Arc<Mutex<Option<RecordError>>>,
@@ -79,7 +81,7 @@ impl RecordingWriter {
         sink: Box<dyn RecordingSink>,
         meta: &RecordingMetadata,
     ) -> Result<Self, RecordError> {
-        let (sender, receiver) = sync_channel(BACKGROUND_CALLS);
+        let (sender, receiver) = mailbox(BACKGROUND_CALLS);
         let error = Arc::new(Mutex::new(None));
         let shared = error.clone();
         let owned_path = path.to_path_buf();
@@ -124,7 +126,7 @@ fn serve(
             return Ok(());
         }
     };
-    while let Ok(job) = receiver.recv() {
+    while let Some(job) = receiver.recv() {
         match job {
             Job::Call(call) => {
                 if let Err(e) = call(&mut writer) {
@@ -157,8 +159,14 @@ impl Background {
 
     /// Hand `call` to the writer thread; returns the thread's earlier error, if any.
     pub(super) fn send(&mut self, call: Call) -> Result<(), RecordError> {
+        self.send_as(call, false)
+    }
+
+    /// [`send`](Self::send); `urgent`: wake the writer thread now (someone waits for the
+    /// call), else it takes the call when its queue is half full or at its next poll.
+    fn send_as(&mut self, call: Call, urgent: bool) -> Result<(), RecordError> {
         self.take_error()?;
-        if self.push(call) {
+        if self.push(call, urgent) {
             return Ok(());
         }
         // the thread ended: it met an error (or the writer is finished)
@@ -173,17 +181,20 @@ impl Background {
     pub(super) fn send_unit(&mut self, call: impl FnOnce(&mut RecordingWriter) + Send + 'static) {
         if !self.failed {
             // not sent: the thread ended at an error, which stays for the next call
-            self.push(Box::new(move |w| {
-                call(w);
-                Ok(())
-            }));
+            self.push(
+                Box::new(move |w| {
+                    call(w);
+                    Ok(())
+                }),
+                false,
+            );
         }
     }
 
     /// Hand `call` to the writer thread; whether it is still there to take it.
-    fn push(&mut self, call: Call) -> bool {
+    fn push(&mut self, call: Call, urgent: bool) -> bool {
         match &self.sender {
-            Some(s) => s.send(Job::Call(call)).is_ok(),
+            Some(s) => s.send(Job::Call(call), urgent).is_ok(),
             None => false,
         }
     }
@@ -194,11 +205,14 @@ impl Background {
         call: impl FnOnce(&mut RecordingWriter) -> Result<T, RecordError> + Send + 'static,
     ) -> Result<T, RecordError> {
         let (reply, answer) = sync_channel(1);
-        self.send(Box::new(move |w| {
-            // the caller gets the call's error and decides, as with a plain writer
-            let _ = reply.send(call(w));
-            Ok(())
-        }))?;
+        self.send_as(
+            Box::new(move |w| {
+                // the caller gets the call's error and decides, as with a plain writer
+                let _ = reply.send(call(w));
+                Ok(())
+            }),
+            true,
+        )?;
         match answer.recv() {
             Ok(Ok(value)) => Ok(value),
             Ok(Err(e)) => Err(e),
@@ -215,7 +229,7 @@ impl Background {
     pub(super) fn finish(&mut self, sync: bool) -> Result<(), RecordError> {
         self.take_error()?;
         if let Some(s) = self.sender.take() {
-            let _ = s.send(Job::Finish(sync));
+            let _ = s.send(Job::Finish(sync), true);
         }
         self.join_thread()?;
         self.take_error()

@@ -3,6 +3,7 @@
 
 mod background;
 mod channels;
+mod mailbox;
 mod queue;
 
 pub use background::BACKGROUND_CALLS;
