@@ -140,8 +140,7 @@ impl Simulation {
             .iter(&app.world)
             .count();
         if options.single_threaded || !options.executor.multi_threaded(particles) {
-            app.schedule
-                .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
+            app.set_single_threaded();
         }
         if let Some(frame) = &options.resume_from {
             pipeline

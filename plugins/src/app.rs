@@ -90,6 +90,9 @@ pub struct SimApp {
     plugins: Vec<FinishHook>,
     plugin_names: Vec<String>,
     plugin_params: Vec<serde_json::Value>,
+    /// The schedule runs one system after the other on a thread of rayon's pool
+    /// ([`Self::set_single_threaded`]).
+    in_pool: bool,
 }
 
 impl Default for SimApp {
@@ -114,6 +117,7 @@ impl SimApp {
             plugins: Vec::new(),
             plugin_names: Vec::new(),
             plugin_params: Vec::new(),
+            in_pool: false,
         }
     }
 
@@ -280,9 +284,29 @@ impl SimApp {
             .map_err(ScheduleError)
     }
 
-    /// Run one step of the simulation schedule.
+    /// Run the per-step schedule's systems one after the other (bevy's single-threaded
+    /// executor), each step on a thread of rayon's pool ([`Self::step`]). The systems' own
+    /// parallel loops then run as nested jobs of that pool instead of being handed to it from
+    /// outside, which costs two cross-thread wake-ups per loop (a system's thread blocks until
+    /// the pool is done). Same results, bitwise, as either executor. Setting another executor
+    /// on [`Self::schedule`] afterwards is the caller's business: this app keeps stepping
+    /// inside the pool.
+    pub fn set_single_threaded(&mut self) -> &mut Self {
+        self.schedule
+            .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
+        self.in_pool = true;
+        self
+    }
+
+    /// Run one step of the simulation schedule (inside rayon's pool after
+    /// [`Self::set_single_threaded`]).
     pub fn step(&mut self) {
-        self.schedule.run(&mut self.world);
+        if self.in_pool {
+            let (schedule, world) = (&mut self.schedule, &mut self.world);
+            magsep_systems::par::in_rayon_pool(|| schedule.run(world));
+        } else {
+            self.schedule.run(&mut self.world);
+        }
     }
 
     /// Run the observe schedule once (replay).
