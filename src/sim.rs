@@ -140,7 +140,8 @@ impl Simulation {
             .iter(&app.world)
             .count();
         if options.single_threaded || !options.executor.multi_threaded(particles) {
-            app.set_single_threaded();
+            // steps inside rayon's pool where per-particle loops go parallel
+            app.set_single_threaded(particles >= crate::scene::pipeline::SMALL_SCENE_PARTICLES);
         }
         if let Some(frame) = &options.resume_from {
             pipeline

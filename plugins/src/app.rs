@@ -285,21 +285,22 @@ impl SimApp {
     }
 
     /// Run the per-step schedule's systems one after the other (bevy's single-threaded
-    /// executor), each step on a thread of rayon's pool ([`Self::step`]). The systems' own
-    /// parallel loops then run as nested jobs of that pool instead of being handed to it from
-    /// outside, which costs two cross-thread wake-ups per loop (a system's thread blocks until
-    /// the pool is done). Same results, bitwise, as either executor. Setting another executor
-    /// on [`Self::schedule`] afterwards is the caller's business: this app keeps stepping
-    /// inside the pool.
-    pub fn set_single_threaded(&mut self) -> &mut Self {
+    /// executor); `in_pool`: each step on a thread of rayon's pool ([`Self::step`]). The
+    /// systems' own parallel loops then run as nested jobs of that pool instead of being handed
+    /// to it from outside, which costs two cross-thread wake-ups per loop (the system's thread
+    /// blocks until the pool is done); entering the pool costs the same once per step, so it
+    /// pays only for scenes whose steps run parallel loops (the `magsep` driver asks for it from
+    /// 256 particles, where per-particle loops go parallel). Same results, bitwise, either way.
+    /// Setting another executor on [`Self::schedule`] afterwards is the caller's business.
+    pub fn set_single_threaded(&mut self, in_pool: bool) -> &mut Self {
         self.schedule
             .set_executor(bevy_ecs::schedule::SingleThreadedExecutor::new());
-        self.in_pool = true;
+        self.in_pool = in_pool;
         self
     }
 
-    /// Run one step of the simulation schedule (inside rayon's pool after
-    /// [`Self::set_single_threaded`]).
+    /// Run one step of the simulation schedule (inside rayon's pool when
+    /// [`Self::set_single_threaded`] asked for it).
     pub fn step(&mut self) {
         if self.in_pool {
             let (schedule, world) = (&mut self.schedule, &mut self.world);
