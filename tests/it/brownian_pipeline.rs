@@ -197,6 +197,25 @@ fn the_fixed_step_is_bitwise_identical_for_one_and_two_threads() {
         bits(&a) == bits(&c),
         "1 vs 2 threads, multi-threaded executor"
     );
+    // stepped from this (non-pool) thread: each step inside the global pool (what the driver
+    // asks for from 256 particles) and each parallel loop handed to the pool from here
+    let outside = |in_pool: bool| {
+        let options = RunOptions {
+            single_threaded: true,
+            ..Default::default()
+        };
+        let mut sim = Simulation::from_scene(&s, options).unwrap();
+        sim.app.set_single_threaded(in_pool);
+        for _ in 0..40 {
+            sim.step();
+        }
+        positions(&mut sim)
+    };
+    assert!(bits(&a) == bits(&outside(true)), "stepping inside the pool");
+    assert!(
+        bits(&a) == bits(&outside(false)),
+        "stepping outside the pool"
+    );
 }
 
 fn identical_for_one_and_two_threads(kind: &str) {
