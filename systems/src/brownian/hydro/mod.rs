@@ -45,6 +45,8 @@ mod tests;
 mod tests_ewald;
 #[cfg(test)]
 mod tests_noise;
+#[cfg(test)]
+mod tests_pse;
 
 pub use ewald::EwaldSummary;
 pub use rpy::{rpy_block, rpy_matrix};

@@ -46,6 +46,23 @@
 //! N = 1000 at φ = 0.01) nothing is stored: every product streams all pairs (`direct`,
 //! vectorised, O(N²) flops, O(N) memory).
 //!
+//! # Towards positively split Ewald (PSE) noise
+//! The noise currently takes μ^{1/2}w by Lanczos over the whole product. PSE (Fiore, Balboa
+//! Usabiaga, Donev & Swan, J. Chem. Phys. 146, 124116 (2017)) would write
+//! μ^{1/2}w = μ_real^{1/2}w₁ + μ_wave^{1/2}w₂, needing both parts positive semidefinite.
+//! For equal radii a the wave part here has the transform Ŝ(k)e^{−k²/4ξ²}(1 + k²/4ξ² − a²k²/3)
+//! (semidefinite for ξa ≤ √3/2) and the real part Ŝ(k)[sinc²(ka) − e^{−x}(1 + x − a²k²/3)],
+//! x = k²/4ξ², which is not positive for every ξ (most negative value relative to k → 0:
+//! −4e-4 at ξa = 0.5, −2.6e-6 at 0.4, −2.6e-11 at 0.3, near ka = π; Fiore et al. put sinc² in
+//! the wave part instead). So at ξa ≤ 0.3 (the cost model picks ξa ≈ 0.1 at φ = 0.01) the
+//! existing split is positive (tested: `tests_pse`); for unequal radii the two-density wave
+//! part is indefinite. What is missing is a direct sampler of μ_wave: sampling the grid field
+//! by circulant embedding (white noise on the n³ FFT grid, times a 3×3 factor of the kernel's
+//! spectrum) is *not* exact in free space, because the DFT of the real-space-sampled,
+//! truncated Stokeslet is indefinite at the lowest wavenumbers (−2.5 % of its largest
+//! eigenvalue on a 40³ grid; the sample covariance came out ≈ 20 % off). Periodic PSE does not
+//! have this problem; a free-space sampler needs a positive embedding of the 1/r tail.
+//!
 //! # Determinism
 //! Every stage is parallel over independent rows, grid planes or FFT lines, each summed in a
 //! fixed order, so results are bitwise identical for every rayon thread count.
@@ -151,6 +168,15 @@ impl SpectralEwald {
         }
         if let Some(w) = &self.wave {
             w.apply_add(x, out);
+        }
+    }
+
+    /// out = μ_real x, the pair part alone (μ − μ_wave; the whole μ for the direct sum).
+    #[cfg(test)]
+    pub fn apply_real(&self, x: &[f64], out: &mut [f64]) {
+        match &self.real {
+            Real::Near(near) => near.apply(x, out),
+            Real::Direct(direct) => direct.apply(x, out),
         }
     }
 

@@ -61,19 +61,25 @@ fn pair(r: f64, a_i: f64, a_j: f64, viscosity: f64, xi: f64) -> (f64, f64) {
 }
 
 impl Near {
-    /// Builds the blocks for `params` (cut-off, ξ).
+    /// Builds the blocks for `params` (cut-off, ξ). Each pair's block is computed once (for
+    /// j > i, in parallel over rows) and mirrored into row j (the block is symmetric: same r,
+    /// same s = a_i² + a_j²); row i holds first its columns k < i in increasing k, then its
+    /// columns j > i in the cell list's order, independent of the thread count.
     pub fn new(params: &Params, positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
         let n = positions.len();
         let xi = params.xi;
         let cells =
             (!params.is_direct()).then(|| CellList::build(positions, params.cutoff, |_| true));
-        let rows: Vec<Row> = (0..n)
+        let upper: Vec<Row> = (0..n)
             .into_par_iter()
             .with_min_len(ROWS)
             .map(|i| {
                 let mut cols = Vec::new();
                 let mut blocks = Vec::new();
                 let mut add = |j: usize, d: DVec3| {
+                    if j <= i {
+                        return;
+                    }
                     let r = d.length();
                     let (iso, dyad) = pair(r, radii[i], radii[j], viscosity, xi);
                     let f = if r > 0.0 { dyad / (r * r) } else { 0.0 };
@@ -83,7 +89,7 @@ impl Near {
                 match &cells {
                     Some(c) => c.for_each_neighbour(positions, i, params.cutoff, &mut add),
                     None => {
-                        for j in (0..n).filter(|&j| j != i) {
+                        for j in i + 1..n {
                             add(j, positions[i] - positions[j]);
                         }
                     }
@@ -100,15 +106,7 @@ impl Near {
                 self_mobility(a, viscosity) - pre * wave
             })
             .collect();
-        let mut start = Vec::with_capacity(n + 1);
-        start.push(0);
-        let mut cols = Vec::new();
-        let mut blocks = Vec::new();
-        for (c, b) in rows {
-            cols.extend(c);
-            blocks.extend(b);
-            start.push(cols.len());
-        }
+        let (start, cols, blocks) = mirror(&upper);
         Self {
             start,
             cols,
@@ -140,5 +138,98 @@ impl Near {
                 oi.copy_from_slice(&[acc.x, acc.y, acc.z]);
             }
         });
+    }
+}
+
+/// The full CSR (start, columns, blocks) from the upper rows (columns j > i): row i gets the
+/// mirrored blocks of every earlier row k that lists i (increasing k), then its own.
+fn mirror(upper: &[Row]) -> (Vec<usize>, Vec<u32>, Vec<(f64, f64)>) {
+    let n = upper.len();
+    let mut lower = vec![0usize; n];
+    for (cols, _) in upper {
+        for &j in cols {
+            lower[j as usize] += 1;
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    start.push(0);
+    for (i, (cols, _)) in upper.iter().enumerate() {
+        start.push(start[i] + lower[i] + cols.len());
+    }
+    let total = start[n];
+    let mut out_cols = vec![0u32; total];
+    let mut out_blocks = vec![(0.0, 0.0); total];
+    // cursor of the next mirrored entry per row
+    let mut cursor: Vec<usize> = start[..n].to_vec();
+    for (k, (cols, blocks)) in upper.iter().enumerate() {
+        let own = start[k] + lower[k];
+        out_cols[own..own + cols.len()].copy_from_slice(cols);
+        out_blocks[own..own + cols.len()].copy_from_slice(blocks);
+        for (&j, &b) in cols.iter().zip(blocks) {
+            let c = &mut cursor[j as usize];
+            out_cols[*c] = k as u32;
+            out_blocks[*c] = b;
+            *c += 1;
+        }
+    }
+    (start, out_cols, out_blocks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brownian::hydro::tests::{A, ETA, random_config};
+    use rand::SeedableRng;
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn unit(c: usize) -> DVec3 {
+        let mut e = DVec3::ZERO;
+        e[c] = 1.0;
+        e
+    }
+
+    /// Every 3×3 block of the operator (read column by column through `apply`) equals the
+    /// pair block computed directly for that pair (zero beyond the cut-off), with the
+    /// diagonal's self term: the mirrored half list stores each pair in both rows.
+    #[test]
+    fn mirrored_blocks_equal_the_pair_blocks_in_both_rows() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+        let n = 120;
+        let (pos, radii) = random_config(&mut rng, n, 10.0 * A, true);
+        for cutoff in [Some(3.0 * A), None] {
+            let params = Params::with_cutoff(1e-6, cutoff, &pos, &radii);
+            let near = Near::new(&params, &pos, &radii, ETA);
+            let (mut x, mut out) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
+            let mut stored = 0;
+            let mut worst = 0.0_f64;
+            for col in 0..3 * n {
+                x.fill(0.0);
+                x[col] = 1.0;
+                near.apply(&x, &mut out);
+                let j = col / 3;
+                for i in 0..n {
+                    let d = pos[i] - pos[j];
+                    let expect = if i == j {
+                        unit(col % 3) * near.diag[i]
+                    } else if d.length() < params.cutoff {
+                        let r = d.length();
+                        let (iso, dyad) = pair(r, radii[i], radii[j], ETA, params.xi);
+                        let e = unit(col % 3);
+                        e * iso + d * (dyad / (r * r) * d.dot(e))
+                    } else {
+                        DVec3::ZERO
+                    };
+                    if i != j && expect != DVec3::ZERO {
+                        stored += 1;
+                    }
+                    let got = DVec3::new(out[3 * i], out[3 * i + 1], out[3 * i + 2]);
+                    let scale = 1.0 / (6.0 * PI * ETA * A);
+                    worst = worst.max((got - expect).abs().max_element() / scale);
+                }
+            }
+            assert!(worst < 1e-13, "{cutoff:?}: {worst}");
+            assert_eq!(stored / 3, near.pairs(), "{cutoff:?}");
+            assert!(near.pairs() > n, "{cutoff:?}: {}", near.pairs());
+        }
     }
 }
