@@ -139,7 +139,11 @@ impl Simulation {
             .query_filtered::<(), With<ParticleId>>()
             .iter(&app.world)
             .count();
-        if options.single_threaded || !options.executor.multi_threaded(particles) {
+        let executor = match options.executor {
+            ExecutorChoice::Auto => pipeline.executor(),
+            chosen => chosen,
+        };
+        if options.single_threaded || !executor.multi_threaded(particles) {
             // steps inside rayon's pool where per-particle loops go parallel
             app.set_single_threaded(particles >= crate::scene::pipeline::SMALL_SCENE_PARTICLES);
         }

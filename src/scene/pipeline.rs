@@ -315,6 +315,15 @@ pub trait Pipeline: Send + Sync + 'static {
         true
     }
 
+    /// How the schedule runs when the run leaves the choice to the scene
+    /// ([`ExecutorChoice::Auto`]). Default: `Auto` (by the scene's size). A pipeline whose
+    /// systems form one chain, each splitting its own work among threads, gains nothing from
+    /// bevy's multi-threaded executor and pays its hand-offs: it answers `SingleThreaded`
+    /// (the steps then run inside rayon's pool from [`SMALL_SCENE_PARTICLES`] particles).
+    fn executor(&self) -> ExecutorChoice {
+        ExecutorChoice::Auto
+    }
+
     /// Type and check this pipeline's sections and particle keys, pushing every problem at
     /// its key path; the returned data is kept in the [`Scene`].
     fn parse(&self, cx: &mut ParseContext<'_>) -> Option<SceneSection>;
