@@ -10,8 +10,8 @@
 //!   that follows `step_halvings` halvings, i.e. a failure at dV_min = dV_0 / 2^h.
 //! * `Adaptive` (default): dV = f * V_free (V_free = V_box - V_particles), clamped to at least
 //!   dV_min. While steps need no overlap removal at all, f doubles (up to 1/4); when a step
-//!   spends more than a quarter of the budget, f halves; after a failure f halves and never
-//!   grows again. It stops on a failure at dV_min: the same final criterion as `Fixed`, so
+//!   spends more than a quarter of the budget and dV > dV_0, f halves; after a failure f halves
+//!   and never grows again. It stops on a failure at dV_min: the same final criterion as `Fixed`, so
 //!   both rules end in statistically the same state (see `magsep chart packing`), but the
 //!   adaptive rule crosses the dilute regime in tens instead of tens of thousands of steps.
 
@@ -140,7 +140,10 @@ pub fn settle_step(
         if p.step_rule == VolumeStepRule::Adaptive {
             if out.attempts == 0 && st.may_grow {
                 st.adaptive_fraction = (st.adaptive_fraction * 2.0).min(0.25);
-            } else if out.attempts > p.max_attempts / 4 {
+            } else if out.attempts > p.max_attempts / 4 && dv > p.volume_step {
+                // expensive steps shrink the step down to the fixed rule's dV_0 only: below
+                // it only failures refine it (as in the thesis); the cost of a removal grows
+                // only slowly with dV, so smaller steps cost more per unit of compression
                 st.adaptive_fraction *= 0.5;
             }
         }
@@ -262,4 +265,62 @@ pub fn run_to_end(
         progress(&st);
     }
     st
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params() -> DriverParams {
+        DriverParams {
+            rule: MoveRule::Revised { dt: 0.1 },
+            step_rule: VolumeStepRule::Adaptive,
+            volume_step: 0.1,
+            step_halvings: 4,
+            adaptive_initial_fraction: 0.01,
+            max_attempts: 1000,
+            tolerance: 1e-4,
+            max_compression_steps: 100,
+        }
+    }
+
+    fn success(attempts: u64) -> RemovalOutcome {
+        RemovalOutcome {
+            success: true,
+            attempts,
+            sweeps: 1,
+            contacts: 0,
+            fallbacks: 0,
+        }
+    }
+
+    fn status(p: &DriverParams) -> PackingStatus {
+        PackingStatus {
+            compression_steps: 0,
+            failed_steps: 0,
+            halvings: 0,
+            volume_step: p.volume_step,
+            adaptive_fraction: 0.01,
+            may_grow: false,
+            attempts: 0,
+            last_attempts: 0,
+            packing_fraction: 0.5,
+            stopped: None,
+            contact_evaluations: 0,
+            contact_fallbacks: 0,
+        }
+    }
+
+    #[test]
+    fn expensive_steps_shrink_the_adaptive_step_only_above_dv0() {
+        let p = params();
+        let mut st = status(&p);
+        settle_step(&p, &mut st, 0.2, success(300), || {});
+        assert_eq!(st.adaptive_fraction, 0.005, "dV > dV_0: halved");
+        settle_step(&p, &mut st, 0.1, success(300), || {});
+        assert_eq!(st.adaptive_fraction, 0.005, "dV = dV_0: kept");
+        settle_step(&p, &mut st, 0.2, success(200), || {});
+        assert_eq!(st.adaptive_fraction, 0.005, "cheap step: kept");
+        assert_eq!(st.compression_steps, 3);
+    }
 }
