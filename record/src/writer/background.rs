@@ -163,7 +163,7 @@ impl Background {
     }
 
     /// [`send`](Self::send); `urgent`: wake the writer thread now (someone waits for the
-    /// call), else it takes the call when its queue is half full or at its next poll.
+    /// call), else it takes the call when its queue is three quarters full or at its next poll.
     fn send_as(&mut self, call: Call, urgent: bool) -> Result<(), RecordError> {
         self.take_error()?;
         if self.push(call, urgent) {
