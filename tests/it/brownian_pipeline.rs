@@ -163,8 +163,9 @@ fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
 
 /// The fixed step on the LAMMPS-mirror configuration (WCA core, dipoles cut at 4 sigma) with
 /// 1331 particles: enough for every parallel path of the step (cell binning, list checks,
-/// pair forces, drift, noise, update and the component passes split among the threads), each
-/// run on one thread and on two, and the two trajectories are bitwise the same.
+/// pair forces, drift, noise and update split among the threads), each run on one thread and
+/// on two, on both executors and stepped inside and outside rayon's pool, and every trajectory
+/// is bitwise the same.
 #[test]
 fn the_fixed_step_is_bitwise_identical_for_one_and_two_threads() {
     let s = scene(&magsep::studies::bench_brownian::lammps_mirror_scene(11, 3).unwrap());
