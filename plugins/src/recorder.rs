@@ -60,15 +60,22 @@ pub fn recording_error(world: &World) -> Option<&str> {
         .and_then(|r| r.error.as_deref())
 }
 
-/// Wall time spent writing frames (a resource, present only when a caller measures the
+/// Time spent writing frames (a resource, present only when a caller measures the
 /// recording's cost, e.g. `magsep bench recording`): [`record_now`] adds the time it takes to
-/// gather, encode and write each frame.
+/// gather each frame and hand it to the writer.
 #[derive(Resource, Debug, Clone, Copy, Default, PartialEq)]
 pub struct RecordTiming {
-    /// Time spent in [`record_now`] writing frames \[s\].
+    /// Wall time spent in [`record_now`] writing frames \[s\].
     pub seconds: f64,
+    /// The calling thread's CPU time in [`record_now`] \[s\] (Linux; elsewhere the wall
+    /// time): unlike the wall time, not lengthened when a loaded machine preempts the thread.
+    pub cpu_seconds: f64,
     /// Frames written.
     pub frames: u64,
+    /// The longest single frame's time \[s\] (a stall shows here, not in a mean).
+    pub max_seconds: f64,
+    /// The step of that longest frame.
+    pub max_step: u64,
 }
 
 /// A function giving one key of a frame's status (`None`: leave the key out).
@@ -230,6 +237,7 @@ pub fn record_now(world: &mut World) {
         return;
     }
     let started = std::time::Instant::now();
+    let cpu_started = thread_cpu_seconds();
     let frame = gather_frame(world);
     let colours: Option<Vec<[f32; 4]>> = world
         .get_resource::<ColourProvider>()
@@ -251,9 +259,45 @@ pub fn record_now(world: &mut World) {
         _ => rec.last_step = Some(step),
     }
     if let Some(mut t) = world.get_resource_mut::<RecordTiming>() {
-        t.seconds += started.elapsed().as_secs_f64();
+        let dt = started.elapsed().as_secs_f64();
+        t.seconds += dt;
+        t.cpu_seconds += match (cpu_started, thread_cpu_seconds()) {
+            (Some(a), Some(b)) => b - a,
+            _ => dt,
+        };
         t.frames += 1;
+        if dt > t.max_seconds {
+            t.max_seconds = dt;
+            t.max_step = step;
+        }
     }
+}
+
+/// The calling thread's CPU time \[s\] (`None` where the platform does not say).
+pub fn thread_cpu_seconds() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    return cpu_clock(libc::CLOCK_THREAD_CPUTIME_ID);
+    #[cfg(not(target_os = "linux"))]
+    None
+}
+
+/// The process's CPU time, all its threads \[s\] (`None` where the platform does not say).
+pub fn process_cpu_seconds() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    return cpu_clock(libc::CLOCK_PROCESS_CPUTIME_ID);
+    #[cfg(not(target_os = "linux"))]
+    None
+}
+
+#[cfg(target_os = "linux")]
+fn cpu_clock(clock: libc::clockid_t) -> Option<f64> {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec for the call to fill
+    let rc = unsafe { libc::clock_gettime(clock, &mut ts) };
+    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
 }
 
 /// Whether this step's frame is due (the run condition of [`record_frame`], which as an

@@ -14,18 +14,23 @@
 //!   time (building the simulation, opening the file, the first and last frame and closing the
 //!   file included; `build_s` the building alone; `wall_ratio_min`,
 //!   `wall_ratio_max` its spread), the median wall times, the time spent writing frames
-//!   (measured inside the recorder, [`RecordTiming`]) and closing the file, and
+//!   (measured inside the recorder, [`RecordTiming`]; per frame the median over the rounds:
+//!   `record_s_per_frame` in wall time, `record_cpu_s_per_frame` in the simulation thread's CPU
+//!   time, which a loaded machine's preemptions do not lengthen; `record_s_max_frame` and
+//!   `max_frame_step` the longest single frame) and closing the file, and
 //!   `overhead_fraction`: that time over
 //!   the time of the steps, extrapolated to the scene's full run (`frames_full_run` frames:
 //!   one every `every` steps plus the first and the last) where the pipeline knows its length
 //!   (else over the timed window): `frames_overhead_fraction` counts the frames only,
+//!   `cpu_overhead_fraction` the frames' CPU time (on the thread that records) over the CPU
+//!   time, all threads, that the same steps take in the rounds that do not record,
 //!   `overhead_fraction` also the one-off closing of the file (`finish_s`: the summary
 //!   record, the summary section and the footer).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use magsep_plugins::recorder::{RecordTiming, record_now};
+use magsep_plugins::recorder::{RecordTiming, process_cpu_seconds, record_now};
 use serde_json::json;
 
 use crate::scene::{ExecutorChoice, RecordEvery, Registry, Scene, parse_scene};
@@ -178,7 +183,15 @@ struct Window {
     build_s: f64,
     steps: u64,
     record_s: f64,
+    /// The recording thread's CPU time in the recorder (in `record_s`'s stead where the
+    /// platform does not say).
+    record_cpu_s: f64,
+    /// The process's CPU time over the steps and frames (the wall time where the platform
+    /// does not say).
+    stepping_cpu_s: f64,
     frames: u64,
+    /// The longest frame \[s\] and its step.
+    max_frame: (f64, u64),
     finish_s: f64,
     bytes: u64,
 }
@@ -195,6 +208,7 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
         .map_err(|e| runtime("recording scene")(e.to_string()))?;
     let build_s = t0.elapsed().as_secs_f64();
     sim.app.world.insert_resource(RecordTiming::default());
+    let (w0, c0) = (Instant::now(), process_cpu_seconds());
     record_now(&mut sim.app.world);
     let mut done = 0;
     while done < steps && !sim.is_finished() {
@@ -202,6 +216,10 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
         done += 1;
     }
     record_now(&mut sim.app.world);
+    let stepping_cpu_s = match (c0, process_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => w0.elapsed().as_secs_f64(),
+    };
     let t1 = Instant::now();
     let summary = sim.summary();
     sim.finish_recording(&summary)
@@ -221,7 +239,10 @@ fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window,
         build_s,
         steps: done,
         record_s: timing.seconds,
+        record_cpu_s: timing.cpu_seconds,
+        stepping_cpu_s,
         frames: timing.frames,
+        max_frame: (timing.max_seconds, timing.max_step),
         finish_s: if record.is_some() { finish_s } else { 0.0 },
         bytes,
     })
@@ -285,7 +306,13 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
             build_s: sum(|w| w.build_s),
             steps: pairs.iter().map(|(_, r)| r.steps).sum(),
             record_s: sum(|w| w.record_s),
+            record_cpu_s: sum(|w| w.record_cpu_s),
+            stepping_cpu_s: sum(|w| w.stepping_cpu_s),
             frames: pairs.iter().map(|(_, r)| r.frames).sum(),
+            max_frame: pairs
+                .iter()
+                .map(|(_, r)| r.max_frame)
+                .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a }),
             finish_s: sum(|w| w.finish_s) / pairs.len() as f64,
             bytes: pairs.last().map_or(0, |(_, r)| r.bytes),
         };
@@ -304,23 +331,35 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
         let recording_s = rec.record_s + rec.finish_s * rounds;
         let stepping_s = (rec.wall_s - rec.build_s - recording_s).max(1e-12);
         let step_s = stepping_s / rec.steps.max(1) as f64;
-        let frame_s = rec.record_s / rec.frames.max(1) as f64;
+        // per frame: the median over the rounds, so that one round's preemption on a loaded
+        // machine does not carry the figure (the longest frame is reported apart)
+        let per_frame = |f: fn(&Window) -> f64| {
+            median(
+                pairs
+                    .iter()
+                    .map(|(_, r)| f(r) / r.frames.max(1) as f64)
+                    .collect(),
+            )
+        };
+        let frame_s = per_frame(|w| w.record_s);
+        let frame_cpu_s = per_frame(|w| w.record_cpu_s);
         let total = scene.pipeline.as_ref().and_then(|p| p.total_steps(&scene));
         let window_fraction = recording_s / stepping_s;
-        let window_frames = rec.record_s / stepping_s;
-        let (frames_full, fraction_full, frames_fraction) = match total {
-            Some(t) if t > 0 => {
-                let frames = t / every.max(1) + 2;
-                let run = t as f64 * step_s;
-                let cost = frames as f64 * frame_s;
-                (frames, (cost + rec.finish_s) / run, cost / run)
-            }
-            _ => (
-                rec.frames / pairs.len() as u64,
-                window_fraction,
-                window_frames,
-            ),
+        let frames_per_window = rec.frames as f64 / rounds;
+        let window_steps = (rec.steps as f64 / rounds).max(1.0);
+        // (frames over the scene's full run, their cost, that cost's CPU time) over the run
+        let (frames_full, run_s) = match total {
+            Some(t) if t > 0 => (t / every.max(1) + 2, t as f64 * step_s),
+            _ => (frames_per_window as u64, window_steps * step_s),
         };
+        let frames_fraction = frames_full as f64 * frame_s / run_s;
+        // the frames' CPU time against the CPU time per step of the runs that do not record
+        // (all their threads: a recorded run's would include the writer thread's)
+        let plain_steps: u64 = pairs.iter().map(|(p, _)| p.steps).sum();
+        let plain_cpu: f64 = pairs.iter().map(|(p, _)| p.stepping_cpu_s).sum();
+        let run_cpu_s = run_s / step_s * plain_cpu.max(1e-12) / plain_steps.max(1) as f64;
+        let cpu_fraction = frames_full as f64 * frame_cpu_s / run_cpu_s;
+        let fraction_full = (frames_full as f64 * frame_s + rec.finish_s) / run_s;
         emit(
             &mut rows,
             as_json,
@@ -334,11 +373,15 @@ pub fn bench_recording(as_json: bool, quick: bool) -> Result<(), BenchError> {
                    "wall_ratio_min": ratios.iter().copied().fold(f64::INFINITY, f64::min),
                    "wall_ratio_max": ratios.iter().copied().fold(0.0, f64::max),
                    "frames": rec.frames / pairs.len() as u64, "bytes": rec.bytes,
-                   "record_s_per_frame": frame_s, "finish_s": rec.finish_s,
+                   "record_s_per_frame": frame_s,
+                   "record_cpu_s_per_frame": frame_cpu_s,
+                   "record_s_max_frame": rec.max_frame.0, "max_frame_step": rec.max_frame.1,
+                   "finish_s": rec.finish_s,
                    "step_s": step_s,
                    "window_overhead_fraction": window_fraction,
                    "full_run_steps": total, "frames_full_run": frames_full,
                    "frames_overhead_fraction": frames_fraction,
+                   "cpu_overhead_fraction": cpu_fraction,
                    "overhead_fraction": fraction_full}),
         )?;
     }

@@ -11,11 +11,12 @@
 //! writer, which closes the file best-effort, so what was written stays readable); the next
 //! call returns it (the same error as a plain writer's call would have returned, one call
 //! later), and every call after that an error saying the recording stopped. Memory is bounded:
-//! at most [`BACKGROUND_CALLS`] calls wait in the queue, the caller blocks when it is full.
+//! at most [`BACKGROUND_CALLS`] calls and [`BACKGROUND_BYTES`] of their data wait in the queue,
+//! the caller blocks when it is full.
 
 use super::mailbox::{Receiver, Sender, mailbox};
 use super::{RecordingSink, RecordingWriter};
-use crate::{RecordError, RecordingMetadata};
+use crate::{ParticleFrame, RecordError, RecordingMetadata};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::sync_channel;
@@ -24,7 +25,14 @@ use std::thread::JoinHandle;
 
 /// Most calls waiting for the writer thread (each one frame at most); a caller that gets
 /// this far ahead waits (back-pressure).
-pub const BACKGROUND_CALLS: usize = 16;
+pub const BACKGROUND_CALLS: usize = 256;
+
+/// Most bytes (as estimated by each call's weight) waiting for the writer thread; a caller
+/// that gets this far ahead waits.
+pub const BACKGROUND_BYTES: usize = 32 << 20;
+
+/// The weight of a call whose data is not counted (a few hundred bytes at most).
+const SMALL_CALL: usize = 256;
 
 /// One call to make on the writer thread's [`RecordingWriter`].
 pub(super) type Call = Box<dyn FnOnce(&mut RecordingWriter) -> Result<(), RecordError> + Send>;
@@ -81,7 +89,7 @@ impl RecordingWriter {
         sink: Box<dyn RecordingSink>,
         meta: &RecordingMetadata,
     ) -> Result<Self, RecordError> {
-        let (sender, receiver) = mailbox(BACKGROUND_CALLS);
+        let (sender, receiver) = mailbox(BACKGROUND_CALLS, BACKGROUND_BYTES);
         let error = Arc::new(Mutex::new(None));
         let shared = error.clone();
         let owned_path = path.to_path_buf();
@@ -158,15 +166,31 @@ impl Background {
     }
 
     /// Hand `call` to the writer thread; returns the thread's earlier error, if any.
-    pub(super) fn send(&mut self, call: Call) -> Result<(), RecordError> {
-        self.send_as(call, false)
+    /// `weight`: the call's data in bytes, roughly ([`SMALL_CALL`] if it carries little).
+    pub(super) fn send(&mut self, call: Call, weight: usize) -> Result<(), RecordError> {
+        self.send_as(call, weight.max(SMALL_CALL), false)
+    }
+
+    /// Hand a frame to the writer thread, weighed by what it holds: 14 words per particle
+    /// (16 with colours) and its status.
+    pub(super) fn send_frame(
+        &mut self,
+        frame: ParticleFrame,
+        colours: Option<Vec<[f32; 4]>>,
+    ) -> Result<(), RecordError> {
+        let per_particle = if colours.is_some() { 128 } else { 112 };
+        let weight = frame.ids.len() * per_particle + frame.status_json.len();
+        self.send(
+            Box::new(move |w| w.write_frame_owned(frame, colours)),
+            weight,
+        )
     }
 
     /// [`send`](Self::send); `urgent`: wake the writer thread now (someone waits for the
     /// call), else it takes the call when its queue is three quarters full or at its next poll.
-    fn send_as(&mut self, call: Call, urgent: bool) -> Result<(), RecordError> {
+    fn send_as(&mut self, call: Call, weight: usize, urgent: bool) -> Result<(), RecordError> {
         self.take_error()?;
-        if self.push(call, urgent) {
+        if self.push(call, weight, urgent) {
             return Ok(());
         }
         // the thread ended: it met an error (or the writer is finished)
@@ -186,15 +210,16 @@ impl Background {
                     call(w);
                     Ok(())
                 }),
+                SMALL_CALL,
                 false,
             );
         }
     }
 
     /// Hand `call` to the writer thread; whether it is still there to take it.
-    fn push(&mut self, call: Call, urgent: bool) -> bool {
+    fn push(&mut self, call: Call, weight: usize, urgent: bool) -> bool {
         match &self.sender {
-            Some(s) => s.send(Job::Call(call), urgent).is_ok(),
+            Some(s) => s.send(Job::Call(call), weight, urgent).is_ok(),
             None => false,
         }
     }
@@ -211,6 +236,7 @@ impl Background {
                 let _ = reply.send(call(w));
                 Ok(())
             }),
+            SMALL_CALL,
             true,
         )?;
         match answer.recv() {
@@ -229,7 +255,7 @@ impl Background {
     pub(super) fn finish(&mut self, sync: bool) -> Result<(), RecordError> {
         self.take_error()?;
         if let Some(s) = self.sender.take() {
-            let _ = s.send(Job::Finish(sync), true);
+            let _ = s.send(Job::Finish(sync), 0, true);
         }
         self.join_thread()?;
         self.take_error()

@@ -121,10 +121,14 @@ impl RecordingWriter {
     ) -> Result<(), RecordError> {
         if let Some(bg) = &mut self.background {
             let owned: Vec<_> = messages.iter().map(|m| (m.0, m.1, m.2.to_vec())).collect();
-            return bg.send(Box::new(move |w| {
-                let borrowed: Vec<_> = owned.iter().map(|m| (m.0, m.1, &m.2[..])).collect();
-                w.write_messages(&borrowed)
-            }));
+            let weight = owned.iter().map(|m| m.2.len()).sum();
+            return bg.send(
+                Box::new(move |w| {
+                    let borrowed: Vec<_> = owned.iter().map(|m| (m.0, m.1, &m.2[..])).collect();
+                    w.write_messages(&borrowed)
+                }),
+                weight,
+            );
         }
         for (channel, _, _) in messages {
             if self.channels.get(channel.index).map(|c| c.id) != Some(channel.id) {

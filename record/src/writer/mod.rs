@@ -6,7 +6,7 @@ mod channels;
 mod mailbox;
 mod queue;
 
-pub use background::BACKGROUND_CALLS;
+pub use background::{BACKGROUND_BYTES, BACKGROUND_CALLS};
 pub use queue::FrameBuffering;
 
 pub use channels::ChannelHandle;
@@ -307,7 +307,7 @@ impl RecordingWriter {
         if let Some(bg) = &mut self.background {
             self.frames_written += 1;
             let (frame, colours) = (frame.into_owned(), colours.map(Cow::into_owned));
-            return bg.send(Box::new(move |w| w.write_frame_owned(frame, colours)));
+            return bg.send_frame(frame, colours);
         }
         if let Some(e) = self.deferred_error.take() {
             return Err(e);
@@ -460,7 +460,7 @@ impl RecordingWriter {
             // a copy is cheaper than its JSON text (formatting the numbers): leave that to
             // the writer thread
             let summary = summary.clone();
-            return bg.send(Box::new(move |w| w.write_summary_value(&summary)));
+            return bg.send(Box::new(move |w| w.write_summary_value(&summary)), 0);
         }
         let entries = BTreeMap::from([("summary".to_string(), summary.to_string())]);
         self.write_metadata(SUMMARY_METADATA_NAME, entries)
@@ -533,7 +533,7 @@ impl RecordingWriter {
     ) -> Result<(), RecordError> {
         if let Some(bg) = &mut self.background {
             let name = name.to_string();
-            return bg.send(Box::new(move |w| w.write_metadata(&name, entries)));
+            return bg.send(Box::new(move |w| w.write_metadata(&name, entries)), 0);
         }
         self.drain_queue()?;
         let metadata = Metadata {
