@@ -32,10 +32,10 @@ pub struct EngineConfig {
     /// Whether [`CollisionReport::events`] is filled. Default: true.
     pub record_events: bool,
     /// Maximum projected Gauss–Seidel sweeps of the resting-contact solve (0 disables it).
-    /// Default: 100. Range: ≥ 0.
+    /// Default: 50. Range: ≥ 0.
     pub resting_sweeps: u32,
     /// The resting solve stops when no contact velocity changes by more than
-    /// `resting_tolerance · (r_i + r_j)/h` in a sweep [-]. Default: 1e-4. Range: > 0.
+    /// `resting_tolerance · (r_i + r_j)/h` in a sweep [-]. Default: 1e-5. Range: > 0.
     pub resting_tolerance: f64,
     /// Whether the resting-contact solve starts from the previous step's contact impulses.
     /// Default: true.
