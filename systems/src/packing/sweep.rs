@@ -13,6 +13,17 @@
 //! overlap to that accuracy. The first scan, and every scan after a list rebuild (the rebuild
 //! wraps the centres and renumbers the pairs), is full.
 //!
+//! **Contact cache.** The scan keeps each superquadric pair's contact for both directed
+//! entries (the other direction by symmetry: the same overlap, the normal reversed, the contact
+//! points exchanged) with the move counts of both ends, and hands its Newton start to the other
+//! direction too. A move of i that meets a pair whose ends have not moved since the scan takes
+//! that contact instead of solving again: in a sweep where both ends of a pair move, the first
+//! of them finds the pair as scanned, so each such pair costs two solves per sweep instead of
+//! three. The contact is the one of the present poses either way; a new warm-started solve
+//! differs only at the solver's accuracy (~1e-13 D), so the packing is not the old one bit for
+//! bit, but it is still the same for any thread count (the cache is written only by the scan,
+//! between sweeps). Rod pairs (closed-form contacts) are not cached.
+//!
 //! **Sweep** ([`sweep`]). The serial sweep moves the flagged particles one after the other in a
 //! shuffled order, each with its contacts evaluated at that moment. The move of particle i
 //! reads only the poses of i and of its listed neighbours and the cached Newton starts of i's
