@@ -411,7 +411,7 @@ impl NeighbourList {
                 let nb = self.entries[k];
                 if nb.j as usize > i || (nb.j as usize == i && nb.image > [0, 0, 0]) {
                     let idx = self.pairs.len() as u32;
-                    let other = twin[k] as usize;
+                    let other = twin.get(k).map_or(k, |t| *t as usize);
                     self.pair_of_entry[k] = idx;
                     self.pair_of_entry[other] = idx;
                     self.pairs.push(PairEntry {

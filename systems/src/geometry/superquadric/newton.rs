@@ -88,7 +88,7 @@ pub(crate) fn system(
 
 /// Solves `m x = rhs` in place (LU, partial pivoting); false for a zero or non-finite pivot.
 /// The rows are pivoted through a permutation instead of being swapped in memory; the
-/// arithmetic is that of [`solve6_reference`] operation for operation, so the answer is the
+/// arithmetic is that of `solve6_reference` (tests) operation for operation, so the answer is the
 /// same bit for bit (tested).
 #[inline]
 pub(crate) fn solve6(m: &mut [[f64; 6]; 6], rhs: &mut [f64; 6]) -> bool {
