@@ -191,6 +191,8 @@ pub struct NeighbourList {
     pairs: Vec<PairEntry>,
     /// For every directed entry, the index in [`Self::unique`] of its unordered pair.
     pair_of_entry: Vec<u32>,
+    /// For every directed entry, the other direction of its pair.
+    twin: Vec<u32>,
     /// Centres at the last build, scaled with every compression since / D (the reference of
     /// [`Self::note_displacements`]).
     reference: Vec<DVec3>,
@@ -421,6 +423,7 @@ impl NeighbourList {
                 }
             }
         }
+        self.twin = twin;
         self.moved = vec![0.0; n];
         self.reference.clear();
         self.reference.extend_from_slice(&state.positions);
@@ -460,6 +463,12 @@ impl NeighbourList {
     #[inline]
     pub fn pair_of_entry(&self, k: usize) -> usize {
         self.pair_of_entry[k] as usize
+    }
+
+    /// The directed entry of the other direction of entry `k`'s pair (j's entry for i).
+    #[inline]
+    pub fn twin(&self, k: usize) -> usize {
+        self.twin[k] as usize
     }
 
     /// The cached contact solution of entry `k` (a copy).

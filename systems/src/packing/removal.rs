@@ -44,7 +44,7 @@ pub fn overlapping_contacts(
     out: &mut Vec<MoveContact>,
 ) {
     let mut warm = Vec::new();
-    contacts_of(state, list, i, tol, out, &mut warm);
+    contacts_of(state, list, None, i, tol, out, &mut warm);
     let first = list.entry_start(i);
     for (k, w) in warm.into_iter().enumerate() {
         *list.warm_mut(first + k) = w;
@@ -131,7 +131,7 @@ pub fn move_particle(
     scratch: &mut Vec<MoveContact>,
     rng: &mut impl Rng,
 ) -> bool {
-    let p = propose(state, list, i, rule, tol, scratch, rng);
+    let p = propose(state, list, None, i, rule, tol, scratch, rng);
     commit(state, list, i, &p)
 }
 

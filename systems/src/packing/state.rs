@@ -122,6 +122,15 @@ impl PackingState {
         )
     }
 
+    /// Whether the contact of `i` and `j` is the superquadric solver's (not both rods).
+    #[inline]
+    pub fn is_superquadric_pair(&self, i: usize, j: usize) -> bool {
+        !matches!(
+            (self.bodies[i].kind, self.bodies[j].kind),
+            (BodyKind::Rod, BodyKind::Rod)
+        )
+    }
+
     /// [`Self::contact`] with the cached superquadric solution of the pair, updated.
     #[inline]
     pub fn contact_warm(

@@ -13,6 +13,17 @@
 //! overlap to that accuracy. The first scan, and every scan after a list rebuild (the rebuild
 //! wraps the centres and renumbers the pairs), is full.
 //!
+//! **Contact cache.** The scan keeps each superquadric pair's contact for both directed
+//! entries (the other direction by symmetry: the same overlap, the normal reversed, the contact
+//! points exchanged) with the move counts of both ends, and hands its Newton start to the other
+//! direction too. A move of i that meets a pair whose ends have not moved since the scan takes
+//! that contact instead of solving again: in a sweep where both ends of a pair move, the first
+//! of them finds the pair as scanned, so each such pair costs two solves per sweep instead of
+//! three. The contact is the one of the present poses either way; a new warm-started solve
+//! differs only at the solver's accuracy (~1e-13 D), so the packing is not the old one bit for
+//! bit, but it is still the same for any thread count (the cache is written only by the scan,
+//! between sweeps). Rod pairs (closed-form contacts) are not cached.
+//!
 //! **Sweep** ([`sweep`]). The serial sweep moves the flagged particles one after the other in a
 //! shuffled order, each with its contacts evaluated at that moment. The move of particle i
 //! reads only the poses of i and of its listed neighbours and the cached Newton starts of i's
@@ -29,6 +40,7 @@ use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
+use super::contact::PairContact;
 use super::moves::{Displacement, MoveContact, MoveRule, overlap_removal_move};
 use super::neighbour::NeighbourList;
 use super::removal::turn_bound;
@@ -57,6 +69,19 @@ pub struct OverlapTracker {
     /// Scratch: pair marks and selected pairs.
     pair_mark: Vec<bool>,
     selected: Vec<u32>,
+    /// Moves of each particle since the last full scan (the contact cache's clock).
+    version: Vec<u32>,
+    /// Per directed list entry: the superquadric pair contact of the last scan, with the
+    /// versions of both ends it was computed at (see [`Self::cached`]).
+    cache: Vec<Option<CachedContact>>,
+}
+
+/// A scanned pair contact and the move versions of its two ends at the time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CachedContact {
+    version_i: u32,
+    version_j: u32,
+    contact: MoveContact,
 }
 
 /// Contacts evaluated by one scan.
@@ -79,6 +104,10 @@ impl OverlapTracker {
         if self.moved_mark.len() <= i {
             self.moved_mark.resize(i + 1, false);
         }
+        if self.version.len() <= i {
+            self.version.resize(i + 1, 0);
+        }
+        self.version[i] = self.version[i].wrapping_add(1);
         if !self.moved_mark[i] {
             self.moved_mark[i] = true;
             self.moved.push(i as u32);
@@ -88,6 +117,27 @@ impl OverlapTracker {
     /// Force a full scan next time.
     pub fn invalidate(&mut self) {
         self.built = None;
+    }
+
+    /// The contact of list entry `k` (particle `i` with its neighbour `j`) as the last scan
+    /// computed it, if it is still the contact of the present poses: a superquadric pair
+    /// whose ends have not moved since, in the list the scan saw. Within one overlap removal
+    /// only [`sweep`]'s commits move particles, and every moving commit is noted
+    /// ([`Self::note_moved`]).
+    #[inline]
+    pub fn cached(
+        &self,
+        list: &NeighbourList,
+        k: usize,
+        i: usize,
+        j: usize,
+    ) -> Option<MoveContact> {
+        if self.built != Some(list.builds) {
+            return None;
+        }
+        let c = self.cache.get(k).copied().flatten()?;
+        let v = |p: usize| self.version.get(p).copied().unwrap_or(0);
+        (c.version_i == v(i) && c.version_j == v(j)).then_some(c.contact)
     }
 
     /// Set `flags[i]` for every particle with a pair or wall overlap above `tol`, evaluating
@@ -110,6 +160,10 @@ impl OverlapTracker {
             self.overlap.resize(npairs, f64::NEG_INFINITY);
             self.wall.clear();
             self.wall.resize(n, false);
+            self.version.clear();
+            self.version.resize(n, 0);
+            self.cache.clear();
+            self.cache.resize(list.len(), None);
             self.selected.extend(0..npairs as u32);
         } else {
             self.pair_mark.clear();
@@ -128,7 +182,7 @@ impl OverlapTracker {
                     .map(|(p, _)| p as u32),
             );
         }
-        let count = evaluate_pairs(state, list, &self.selected, &mut self.overlap);
+        let count = self.evaluate_pairs(state, list);
         // walls: every particle on a full scan, the moved ones otherwise
         let mut walls = Vec::new();
         let mut wall_of = |i: usize, wall: &mut Vec<bool>| {
@@ -160,34 +214,63 @@ impl OverlapTracker {
     }
 }
 
-/// Evaluate the pairs `selected` (indices into [`NeighbourList::unique`]) in parallel, store
-/// their overlaps in `overlap` and their Newton starts in the list, in `selected` order.
-fn evaluate_pairs(
-    state: &PackingState,
-    list: &mut NeighbourList,
-    selected: &[u32],
-    overlap: &mut [f64],
-) -> ScanCount {
-    let l = &*list;
-    let results: Vec<(f64, bool, Option<WarmStart>)> = selected
-        .par_iter()
-        .with_min_len(SCAN_CHUNK)
-        .map(|&p| {
-            let e = l.unique()[p as usize];
-            let mut warm = l.warm(e.k as usize);
-            let c = state.contact_warm(e.i as usize, e.j as usize, e.shift(state.edges), &mut warm);
-            (c.overlap, c.fallback, warm)
-        })
-        .collect();
-    let mut count = ScanCount::default();
-    for (&p, (o, fallback, warm)) in selected.iter().zip(results) {
-        let k = list.unique()[p as usize].k as usize;
-        *list.warm_mut(k) = warm;
-        overlap[p as usize] = o;
-        count.contacts += 1;
-        count.fallbacks += fallback as u64;
+impl OverlapTracker {
+    /// Evaluate the pairs `selected` (indices into [`NeighbourList::unique`]) in parallel and
+    /// store, in `selected` order, their overlaps, their Newton starts in the list (in both
+    /// directions for superquadric pairs) and their superquadric contacts in the cache (both
+    /// directions, at the present move versions).
+    fn evaluate_pairs(&mut self, state: &PackingState, list: &mut NeighbourList) -> ScanCount {
+        let l = &*list;
+        let results: Vec<(PairContact, Option<WarmStart>)> = self
+            .selected
+            .par_iter()
+            .with_min_len(SCAN_CHUNK)
+            .map(|&p| {
+                let e = l.unique()[p as usize];
+                let mut warm = l.warm(e.k as usize);
+                let c =
+                    state.contact_warm(e.i as usize, e.j as usize, e.shift(state.edges), &mut warm);
+                (c, warm)
+            })
+            .collect();
+        let mut count = ScanCount::default();
+        for (&p, (c, warm)) in self.selected.iter().zip(results) {
+            let e = list.unique()[p as usize];
+            let (i, j, k) = (e.i as usize, e.j as usize, e.k as usize);
+            *list.warm_mut(k) = warm;
+            self.overlap[p as usize] = c.overlap;
+            count.contacts += 1;
+            count.fallbacks += c.fallback as u64;
+            if state.is_superquadric_pair(i, j) {
+                // the other direction: the same contact seen from j (a valid starting point
+                // and contact for j's next move; superquadric contacts are warm-started
+                // Newton solutions, not bit-reproducible anyway)
+                let twin = list.twin(k);
+                *list.warm_mut(twin) = warm.map(|w| WarmStart {
+                    s_a: w.s_b,
+                    s_b: w.s_a,
+                });
+                let (vi, vj) = (self.version[i], self.version[j]);
+                self.cache[k] = Some(CachedContact {
+                    version_i: vi,
+                    version_j: vj,
+                    contact: MoveContact::from(&c),
+                });
+                self.cache[twin] = Some(CachedContact {
+                    version_i: vj,
+                    version_j: vi,
+                    contact: MoveContact {
+                        overlap: c.overlap,
+                        normal: -c.normal,
+                        k: -c.k,
+                        s: c.t,
+                        rc: c.rc_j,
+                    },
+                });
+            }
+        }
+        count
     }
-    count
 }
 
 /// The move of one particle computed from a fixed state: its new Newton starts (one per list
@@ -200,10 +283,13 @@ pub struct Proposal {
 
 /// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls
 /// into `out`, reading the cached Newton starts and writing the updated ones into `warm` (one
-/// per entry of i), without changing the list.
+/// per entry of i), without changing the list. With a `tracker`, superquadric pairs whose
+/// ends have not moved since its last scan take the scanned contact instead of a new solve
+/// ([`OverlapTracker::cached`]).
 pub fn contacts_of(
     state: &PackingState,
     list: &NeighbourList,
+    tracker: Option<&OverlapTracker>,
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
@@ -215,6 +301,13 @@ pub fn contacts_of(
     for k in first..first + list.of(i).len() {
         let nb = list.entry(k);
         let mut w = list.warm(k);
+        if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, nb.j as usize)) {
+            warm.push(w);
+            if c.overlap > tol {
+                out.push(c);
+            }
+            continue;
+        }
         let c = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), &mut w);
         warm.push(w);
         if c.overlap > tol {
@@ -227,9 +320,11 @@ pub fn contacts_of(
 }
 
 /// The move of particle `i` under `rule` in the present state (see [`commit`]).
+#[allow(clippy::too_many_arguments)]
 pub fn propose(
     state: &PackingState,
     list: &NeighbourList,
+    tracker: Option<&OverlapTracker>,
     i: usize,
     rule: MoveRule,
     tol: f64,
@@ -237,7 +332,7 @@ pub fn propose(
     rng: &mut impl Rng,
 ) -> Proposal {
     let mut p = Proposal::default();
-    contacts_of(state, list, i, tol, scratch, &mut p.warm);
+    contacts_of(state, list, tracker, i, tol, scratch, &mut p.warm);
     p.displacement =
         overlap_removal_move(rule, &state.bodies[i], state.orientations[i], scratch, rng);
     p
@@ -303,7 +398,7 @@ pub fn sweep(
             if list.needs_rebuild() {
                 list.build(state);
             }
-            let p = propose(state, list, i, rule, tol, &mut scratch, rng);
+            let p = propose(state, list, Some(tracker), i, rule, tol, &mut scratch, rng);
             if commit(state, list, i, &p) {
                 *attempts += 1;
                 count.moves += 1;
@@ -323,11 +418,14 @@ pub fn sweep(
         }
         let end = (pos + batch).min(order.len());
         let ids = &order[pos..end];
-        let (s, l) = (&*state, &*list);
+        let (s, l, t) = (&*state, &*list, &*tracker);
         let proposals: Vec<Proposal> = ids
             .par_iter()
             .with_max_len(1)
-            .map(|&i| propose(s, l, i, rule, tol, &mut Vec::new(), &mut unused_rng()))
+            .map(|&i| {
+                let mut scratch = Vec::new();
+                propose(s, l, Some(t), i, rule, tol, &mut scratch, &mut unused_rng())
+            })
             .collect();
         round += 1;
         for (m, (&i, p)) in ids.iter().zip(&proposals).enumerate() {
@@ -343,7 +441,16 @@ pub fn sweep(
             let stale = list.of(i).iter().any(|nb| stamp[nb.j as usize] == round);
             let moved = if stale {
                 count.recomputed += 1;
-                let fresh = propose(state, list, i, rule, tol, &mut scratch, &mut no_rng);
+                let fresh = propose(
+                    state,
+                    list,
+                    Some(tracker),
+                    i,
+                    rule,
+                    tol,
+                    &mut scratch,
+                    &mut no_rng,
+                );
                 commit(state, list, i, &fresh)
             } else {
                 commit(state, list, i, p)

@@ -203,3 +203,76 @@ fn superballs_750_steps_on_one_and_two_threads() {
     assert_eq!(st1, st2);
     assert!(one == two);
 }
+
+/// The reference of the sweep's contact cache: every cached contact is the contact a fresh
+/// solve gives for the present poses (to the solver's accuracy), and no cached contact
+/// survives a move of either end.
+#[test]
+fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
+    let tol = 1e-4;
+    let (mut state, mut list) = overlapping(SUPERBALL, 80, 0.5, 4);
+    let mut tracker = OverlapTracker::new();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let mut flags = Vec::new();
+    let (mut hits, mut compared_after_moves) = (0, 0);
+    for round in 0..4 {
+        list.ensure(&mut state);
+        pool(2).install(|| tracker.scan(&state, &mut list, tol, &mut flags));
+        for i in 0..state.len() {
+            let first = list.entry_start(i);
+            for k in first..first + list.of(i).len() {
+                let nb = list.entry(k);
+                let Some(c) = tracker.cached(&list, k, i, nb.j as usize) else {
+                    continue;
+                };
+                hits += 1;
+                compared_after_moves += usize::from(round > 0);
+                let mut warm = None; // a cold solve: GJK/EPA seed, then Newton
+                let f = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), &mut warm);
+                assert!((c.overlap - f.overlap).abs() < 1e-10, "{c:?} {f:?}");
+                if f.overlap > -0.02 {
+                    assert!((c.normal - f.normal).length() < 1e-6, "{c:?} {f:?}");
+                    assert!((c.rc - f.rc_i).length() < 1e-6, "{c:?} {f:?}");
+                }
+            }
+        }
+        let order: Vec<usize> = (0..state.len()).filter(|i| flags[*i]).take(8).collect();
+        let mut attempts = 0;
+        let builds = list.builds;
+        let before = (state.positions.clone(), state.orientations.clone());
+        let rule = MoveRule::Revised { dt: 0.1 };
+        sweep(
+            &mut state,
+            &mut list,
+            &mut tracker,
+            &order,
+            rule,
+            tol,
+            u64::MAX,
+            &mut attempts,
+            1,
+            &mut rng,
+        );
+        assert!(attempts > 0);
+        if list.builds == builds {
+            let moved = |i: usize| {
+                state.positions[i] != before.0[i] || state.orientations[i] != before.1[i]
+            };
+            for &i in order.iter().filter(|i| moved(**i)) {
+                let first = list.entry_start(i);
+                for k in first..first + list.of(i).len() {
+                    let j = list.entry(k).j as usize;
+                    assert!(tracker.cached(&list, k, i, j).is_none(), "moved {i}");
+                    assert!(
+                        tracker.cached(&list, list.twin(k), j, i).is_none(),
+                        "moved {i}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        hits > 500 && compared_after_moves > 100,
+        "{hits} {compared_after_moves}"
+    );
+}
