@@ -36,6 +36,7 @@
 
 pub mod ewald;
 pub mod krylov;
+mod precond;
 pub mod rpy;
 mod select;
 pub mod tea;
@@ -43,6 +44,8 @@ pub mod tea;
 mod tests;
 #[cfg(test)]
 mod tests_ewald;
+#[cfg(test)]
+mod tests_krylov;
 #[cfg(test)]
 mod tests_noise;
 #[cfg(test)]
@@ -135,11 +138,24 @@ impl Default for MobilityOptions {
 
 #[derive(Debug)]
 enum Inner {
-    FreeDraining { mob: Vec<f64> },
-    Cholesky { m: DenseSym, l: faer::Mat<f64> },
-    Tea { m: DenseSym, tea: tea::Tea },
-    Krylov { m: DenseSym },
-    SpectralEwald { op: Box<ewald::SpectralEwald> },
+    FreeDraining {
+        mob: Vec<f64>,
+    },
+    Cholesky {
+        m: DenseSym,
+        l: faer::Mat<f64>,
+    },
+    Tea {
+        m: DenseSym,
+        tea: tea::Tea,
+    },
+    Krylov {
+        m: DenseSym,
+    },
+    SpectralEwald {
+        op: Box<ewald::SpectralEwald>,
+        pc: precond::ClusterFactor,
+    },
 }
 
 /// The mobility prepared at one configuration.
@@ -240,6 +256,7 @@ impl Mobility {
                     viscosity,
                     options.ewald_tolerance,
                 )?),
+                pc: precond::ClusterFactor::new(positions, radii, viscosity),
             },
         };
         Ok(Self {
@@ -282,7 +299,7 @@ impl Mobility {
     #[must_use]
     pub fn ewald_summary(&self) -> Option<EwaldSummary> {
         match &self.inner {
-            Inner::SpectralEwald { op } => Some(op.summary()),
+            Inner::SpectralEwald { op, .. } => Some(op.summary()),
             _ => None,
         }
     }
@@ -308,7 +325,7 @@ impl Mobility {
                 }
                 return;
             }
-            Inner::SpectralEwald { op } => {
+            Inner::SpectralEwald { op, .. } => {
                 let f = flatten(forces);
                 let mut v = vec![0.0; f.len()];
                 op.apply(&f, &mut v);
@@ -343,7 +360,17 @@ impl Mobility {
             }
             Inner::Tea { m, tea } => tea.apply(m, &wf, &mut y),
             Inner::Krylov { m } => y = self.lanczos(|x, o| m.matvec(x, o), &wf)?,
-            Inner::SpectralEwald { op } => y = self.lanczos(|x, o| op.apply(x, o), &wf)?,
+            Inner::SpectralEwald { op, pc } => {
+                // y = L (L⁻¹ μ L⁻ᵀ)^{1/2} w: covariance L G Lᵀ = μ (see `precond`)
+                let g = |x: &[f64], o: &mut [f64]| {
+                    let mut t = x.to_vec();
+                    pc.solve_lt(&mut t);
+                    op.apply(&t, o);
+                    pc.solve_l(o);
+                };
+                y = self.lanczos(g, &wf)?;
+                pc.mul_l(&mut y);
+            }
         }
         unflatten(&y, out);
         Ok(())
