@@ -59,10 +59,10 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
     i
 }
 
-/// Pairs (r/(a_i + a_j), i, j), i < j, with r < REACH·(a_i + a_j), closest first.
-fn close_pairs(positions: &[DVec3], radii: &[f64]) -> Vec<(f64, u32, u32)> {
+/// Pairs (r/(a_i + a_j), i, j), i < j, with r < reach·(a_i + a_j), closest first.
+fn close_pairs(positions: &[DVec3], radii: &[f64], reach: f64) -> Vec<(f64, u32, u32)> {
     let a_max = radii.iter().fold(0.0_f64, |m, a| m.max(*a));
-    let cell = 2.0 * REACH * a_max;
+    let cell = 2.0 * reach * a_max;
     let key = |p: DVec3| -> [i64; 3] {
         let c = (p / cell).floor();
         [c.x as i64, c.y as i64, c.z as i64]
@@ -84,7 +84,7 @@ fn close_pairs(positions: &[DVec3], radii: &[f64]) -> Vec<(f64, u32, u32)> {
                 }
                 let s = radii[i] + radii[j];
                 let ratio = (positions[j] - *p).length() / s;
-                if ratio < REACH {
+                if ratio < reach {
                     pairs.push((ratio, i as u32, j as u32));
                 }
             }
@@ -124,6 +124,11 @@ impl ClusterFactor {
     /// The factor at one configuration (inputs already validated: finite, positive radii and
     /// viscosity).
     pub fn new(positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
+        Self::with_reach(positions, radii, viscosity, REACH)
+    }
+
+    /// As [`ClusterFactor::new`] joining pairs closer than `reach`·(a_i + a_j).
+    pub fn with_reach(positions: &[DVec3], radii: &[f64], viscosity: f64, reach: f64) -> Self {
         let n = positions.len();
         let sqrt_self: Vec<f64> = radii
             .iter()
@@ -131,7 +136,7 @@ impl ClusterFactor {
             .collect();
         let mut parent: Vec<u32> = (0..n as u32).collect();
         let mut size = vec![1usize; n];
-        for (_, i, j) in close_pairs(positions, radii) {
+        for (_, i, j) in close_pairs(positions, radii, reach) {
             let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
             if ri != rj && size[ri as usize] + size[rj as usize] <= MAX_CLUSTER {
                 let (lo, hi) = (ri.min(rj), ri.max(rj));

@@ -28,7 +28,11 @@ fn lanczos_convergence_probe() {
     let radii = vec![a; n];
     let w = flat(&normals(&mut rng, n));
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
-    let pc = precond::ClusterFactor::new(&pos, &radii, ETA);
+    let reach: f64 = std::env::var("PROBE_REACH")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(precond::REACH);
+    let pc = precond::ClusterFactor::with_reach(&pos, &radii, ETA, reach);
     let use_pc = std::env::var("PROBE_PC").is_ok();
     eprintln!(
         "preconditioned {use_pc}, clustered particles {}",
@@ -179,4 +183,61 @@ fn preconditioned_noise_covariance_and_fewer_iterations() {
         plain.iterations
     );
     assert!(mob.krylov_iterations() < plain.iterations);
+}
+
+#[test]
+#[ignore = "probe: cargo test --release -p magsep-systems --lib product_parts_timing -- --ignored --nocapture"]
+fn product_parts_timing() {
+    use std::time::Instant;
+    let (n, a) = (10_000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let f = flat(&normals(&mut rng, n));
+    let t = Instant::now();
+    let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    let t_op = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let op2 = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    let t_op2 = t.elapsed().as_secs_f64();
+    drop(op2);
+    let t = Instant::now();
+    let pc = precond::ClusterFactor::new(&pos, &radii, ETA);
+    let t_pc = t.elapsed().as_secs_f64();
+    let mut v = vec![0.0; 3 * n];
+    let (mut tr, mut tw, mut ts) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..5 {
+        let t = Instant::now();
+        op.apply_real(&f, &mut v);
+        tr.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        op.wave().unwrap().apply_add(&f, &mut v);
+        tw.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let mut x = f.clone();
+        pc.solve_lt(&mut x);
+        pc.solve_l(&mut x);
+        ts.push(t.elapsed().as_secs_f64());
+    }
+    let direct = SpectralEwald::with_cutoff(&pos, &radii, ETA, 1e-4, None).unwrap();
+    let mut exact = vec![0.0; 3 * n];
+    direct.apply(&f, &mut exact);
+    op.apply(&f, &mut v);
+    let num: f64 = v.iter().zip(&exact).map(|(a, b)| (a - b) * (a - b)).sum();
+    eprintln!(
+        "product error against the direct sum {:e}",
+        (num / dot(&exact, &exact)).sqrt()
+    );
+    for x in [&mut tr, &mut tw, &mut ts] {
+        x.sort_by(f64::total_cmp);
+    }
+    eprintln!(
+        "threads {}: prepare {t_op:.4} s (cached kernel {t_op2:.4} s), cluster factor {t_pc:.4} s; per product (medians): real {:.4} s, wave {:.4} s, two solves {:.5} s; {:?}",
+        rayon::current_num_threads(),
+        tr[2],
+        tw[2],
+        ts[2],
+        op.summary()
+    );
 }
