@@ -22,7 +22,9 @@
 //! * [`MobilityMethod::SpectralEwald`]: no matrix at all: the product μF by free-space
 //!   spectral Ewald summation to a relative tolerance [`MobilityOptions::ewald_tolerance`]
 //!   (see [`ewald`], O(N log N) per product for a fixed tolerance), and the noise by Lanczos
-//!   over that product (O(m N log N)).
+//!   over that product (O(m N log N)), preconditioned: y = L (L⁻¹ μ L⁻ᵀ)^{1/2} w with L the
+//!   Cholesky factors of close-pair clusters (see `precond`; covariance μ exactly, fewer
+//!   iterations; y is then not the symmetric square root μ^{1/2} w).
 //!
 //! All dense products are row-chunk parallel (rayon) with a fixed per-element summation
 //! order, so every output is bitwise identical whatever the rayon thread count.
@@ -341,7 +343,8 @@ impl Mobility {
     }
 
     /// y = B w with B Bᵀ ≈ μ (exact for free draining and Cholesky). Linear in w except for
-    /// Krylov (y ≈ μ^{1/2} w). The Brownian displacement is √(2 k_B T)·B·ΔW.
+    /// Krylov (y ≈ μ^{1/2} w) and spectral Ewald (y ≈ L (L⁻¹ μ L⁻ᵀ)^{1/2} w, the Krylov
+    /// tolerance applying to the preconditioned root). The Brownian displacement is √(2 k_B T)·B·ΔW.
     /// Errors only for Krylov when the tolerance is not reached.
     pub fn noise(&self, w: &[DVec3], out: &mut [DVec3]) -> Result<(), HydroError> {
         assert_eq!(w.len(), self.n, "w length");

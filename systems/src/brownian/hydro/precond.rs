@@ -183,7 +183,8 @@ impl ClusterFactor {
         }
     }
 
-    /// Particles in clusters (for reports and tests).
+    /// Particles in clusters (for the tests and probes).
+    #[cfg(test)]
     pub fn clustered(&self) -> usize {
         self.clustered.iter().filter(|c| **c).count()
     }

@@ -241,3 +241,56 @@ fn product_parts_timing() {
         op.summary()
     );
 }
+
+#[test]
+#[ignore = "probe: cargo test --release -p magsep-systems --lib cutoff_cost_probe -- --ignored --nocapture"]
+fn cutoff_cost_probe() {
+    // one step's cost (prepare with a cached kernel + 16 products) against the cut-off, N = 10⁴
+    use std::time::Instant;
+    let (n, a) = (10_000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let f = flat(&normals(&mut rng, n));
+    let rc0 = SpectralEwald::new(&pos, &radii, ETA, 1e-4)
+        .unwrap()
+        .summary()
+        .cutoff;
+    let mut v = vec![0.0; 3 * n];
+    for round in 0..2 {
+        for k in [-1, 0, 1, 2] {
+            let rc = rc0 * 1.25f64.powi(k);
+            let _ = SpectralEwald::with_cutoff(&pos, &radii, ETA, 1e-4, Some(rc)).unwrap();
+            let t = Instant::now();
+            let op = SpectralEwald::with_cutoff(&pos, &radii, ETA, 1e-4, Some(rc)).unwrap();
+            let tp = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            for _ in 0..4 {
+                op.apply(&f, &mut v);
+            }
+            let ta = t.elapsed().as_secs_f64() / 4.0;
+            eprintln!(
+                "round {round} rc/rc0 {:.3}: prepare {tp:.3} s, product {ta:.4} s, step (16 products) {:.3} s; {:?}",
+                rc / rc0,
+                tp + 16.0 * ta,
+                op.summary()
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore = "profile probe (callgrind): the preparation of ewald_product_profile alone"]
+fn ewald_prepare_profile() {
+    // the same configuration and tolerance as `ewald_product_profile`, without the products:
+    // the difference of the two counts is the cost of two products
+    let (n, a) = (10_000, 75e-9);
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, _) = random_config(&mut rng, n, edge, false);
+    let radii = vec![a; n];
+    let _ = normals(&mut rng, n);
+    let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    eprintln!("{:?}", op.summary());
+}
