@@ -13,7 +13,7 @@
 //!   e^{−(1−η)k²/4ξ²}): a spread wavenumber k' aliases onto k = k' − 2π/h; the product of the
 //!   spreading factor at k', the kernel and the gathering factor at k is largest at
 //!   k = η π/h, where it is e^{−2η(1−η/2)Λ_g}. η solves 2η(1−η/2)Λ_g = Λ + δ with the margin
-//!   δ = 0.5 + 0.07Λ ([`alias_margin`]; η ≈ 0.47 / 0.50 / 0.54 / 0.58 at
+//!   δ = 0.5 + 0.07Λ (`alias_margin`; η ≈ 0.47 / 0.50 / 0.54 / 0.58 at
 //!   τ = 1e-2 / 1e-4 / 1e-6 / 1e-8): the smallest η with this margin, because the support grows
 //!   as √η. The fixed η = 0.6 used before had δ = 1.9–2.6 and gave errors 2–30× below τ with
 //!   a support one point wider at τ = 1e-4 (11 instead of 10); measured errors with δ = 1.2
