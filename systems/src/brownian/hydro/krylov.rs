@@ -122,7 +122,7 @@ where
 
 /// T^{1/2} e₁ for the symmetric tridiagonal T with diagonal `alpha` (len m) and
 /// off-diagonal `beta` (len ≥ m − 1; only the first m − 1 are used).
-fn sqrt_t_e1(alpha: &[f64], beta: &[f64]) -> Result<Vec<f64>, HydroError> {
+pub(crate) fn sqrt_t_e1(alpha: &[f64], beta: &[f64]) -> Result<Vec<f64>, HydroError> {
     let m = alpha.len();
     let mut d = alpha.to_vec();
     let mut e = vec![0.0; m];

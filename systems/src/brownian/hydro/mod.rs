@@ -22,7 +22,9 @@
 //! * [`MobilityMethod::SpectralEwald`]: no matrix at all: the product μF by free-space
 //!   spectral Ewald summation to a relative tolerance [`MobilityOptions::ewald_tolerance`]
 //!   (see [`ewald`], O(N log N) per product for a fixed tolerance), and the noise by Lanczos
-//!   over that product (O(m N log N)).
+//!   over that product (O(m N log N)), preconditioned: y = L (L⁻¹ μ L⁻ᵀ)^{1/2} w with L the
+//!   Cholesky factors of close-pair clusters (see `precond`; covariance μ exactly, fewer
+//!   iterations; y is then not the symmetric square root μ^{1/2} w).
 //!
 //! All dense products are row-chunk parallel (rayon) with a fixed per-element summation
 //! order, so every output is bitwise identical whatever the rayon thread count.
@@ -36,6 +38,7 @@
 
 pub mod ewald;
 pub mod krylov;
+mod precond;
 pub mod rpy;
 mod select;
 pub mod tea;
@@ -43,6 +46,8 @@ pub mod tea;
 mod tests;
 #[cfg(test)]
 mod tests_ewald;
+#[cfg(test)]
+mod tests_krylov;
 #[cfg(test)]
 mod tests_noise;
 #[cfg(test)]
@@ -135,11 +140,24 @@ impl Default for MobilityOptions {
 
 #[derive(Debug)]
 enum Inner {
-    FreeDraining { mob: Vec<f64> },
-    Cholesky { m: DenseSym, l: faer::Mat<f64> },
-    Tea { m: DenseSym, tea: tea::Tea },
-    Krylov { m: DenseSym },
-    SpectralEwald { op: Box<ewald::SpectralEwald> },
+    FreeDraining {
+        mob: Vec<f64>,
+    },
+    Cholesky {
+        m: DenseSym,
+        l: faer::Mat<f64>,
+    },
+    Tea {
+        m: DenseSym,
+        tea: tea::Tea,
+    },
+    Krylov {
+        m: DenseSym,
+    },
+    SpectralEwald {
+        op: Box<ewald::SpectralEwald>,
+        pc: precond::ClusterFactor,
+    },
 }
 
 /// The mobility prepared at one configuration.
@@ -240,6 +258,7 @@ impl Mobility {
                     viscosity,
                     options.ewald_tolerance,
                 )?),
+                pc: precond::ClusterFactor::new(positions, radii, viscosity),
             },
         };
         Ok(Self {
@@ -282,7 +301,7 @@ impl Mobility {
     #[must_use]
     pub fn ewald_summary(&self) -> Option<EwaldSummary> {
         match &self.inner {
-            Inner::SpectralEwald { op } => Some(op.summary()),
+            Inner::SpectralEwald { op, .. } => Some(op.summary()),
             _ => None,
         }
     }
@@ -308,7 +327,7 @@ impl Mobility {
                 }
                 return;
             }
-            Inner::SpectralEwald { op } => {
+            Inner::SpectralEwald { op, .. } => {
                 let f = flatten(forces);
                 let mut v = vec![0.0; f.len()];
                 op.apply(&f, &mut v);
@@ -324,7 +343,8 @@ impl Mobility {
     }
 
     /// y = B w with B Bᵀ ≈ μ (exact for free draining and Cholesky). Linear in w except for
-    /// Krylov (y ≈ μ^{1/2} w). The Brownian displacement is √(2 k_B T)·B·ΔW.
+    /// Krylov (y ≈ μ^{1/2} w) and spectral Ewald (y ≈ L (L⁻¹ μ L⁻ᵀ)^{1/2} w, the Krylov
+    /// tolerance applying to the preconditioned root). The Brownian displacement is √(2 k_B T)·B·ΔW.
     /// Errors only for Krylov when the tolerance is not reached.
     pub fn noise(&self, w: &[DVec3], out: &mut [DVec3]) -> Result<(), HydroError> {
         assert_eq!(w.len(), self.n, "w length");
@@ -343,7 +363,17 @@ impl Mobility {
             }
             Inner::Tea { m, tea } => tea.apply(m, &wf, &mut y),
             Inner::Krylov { m } => y = self.lanczos(|x, o| m.matvec(x, o), &wf)?,
-            Inner::SpectralEwald { op } => y = self.lanczos(|x, o| op.apply(x, o), &wf)?,
+            Inner::SpectralEwald { op, pc } => {
+                // y = L (L⁻¹ μ L⁻ᵀ)^{1/2} w: covariance L G Lᵀ = μ (see `precond`)
+                let g = |x: &[f64], o: &mut [f64]| {
+                    let mut t = x.to_vec();
+                    pc.solve_lt(&mut t);
+                    op.apply(&t, o);
+                    pc.solve_l(o);
+                };
+                y = self.lanczos(g, &wf)?;
+                pc.mul_l(&mut y);
+            }
         }
         unflatten(&y, out);
         Ok(())

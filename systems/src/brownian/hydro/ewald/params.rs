@@ -9,11 +9,20 @@
 //! * grid spacing: (π/h)²/(4ξ²) = Λ_g = Λ + 1.5 ln Λ + 1.5, so the Hasimoto factor
 //!   (1 + k²/4ξ²)e^{−k²/4ξ²} at the grid's Nyquist wavenumber π/h is ≈ Λ_g e^{−Λ_g} ≤ e^{−Λ}
 //!   (wave-space truncation; the polynomial factor is why Λ_g > Λ);
-//! * Gaussian split η = 0.6 (spreading and gathering each carry e^{−ηk²/8ξ²}, the middle kernel
-//!   e^{−(1−η)k²/4ξ²}): aliasing of the sampled spreading Gaussian is e^{−2ηΛ_g} and aliasing
-//!   of the middle kernel sampled in real space e^{−4(1−η)Λ_g}, both ≤ e^{−Λ};
+//! * Gaussian split η (spreading and gathering each carry e^{−ηk²/8ξ²}, the middle kernel
+//!   e^{−(1−η)k²/4ξ²}): a spread wavenumber k' aliases onto k = k' − 2π/h; the product of the
+//!   spreading factor at k', the kernel and the gathering factor at k is largest at
+//!   k = η π/h, where it is e^{−2η(1−η/2)Λ_g}. η solves 2η(1−η/2)Λ_g = Λ + δ with the margin
+//!   δ = 0.5 + 0.07Λ (`alias_margin`; η ≈ 0.47 / 0.50 / 0.54 / 0.58 at
+//!   τ = 1e-2 / 1e-4 / 1e-6 / 1e-8): the smallest η with this margin, because the support grows
+//!   as √η. The fixed η = 0.6 used before had δ = 1.9–2.6 and gave errors 2–30× below τ with
+//!   a support one point wider at τ = 1e-4 (11 instead of 10); measured errors with δ = 1.2
+//!   were τ/6 … τ/1.03 (the last at τ = 1e-8, hence δ growing with Λ). The middle kernel,
+//!   sampled in real space, aliases as e^{−4(1−η)Λ_g} ≪ e^{−Λ};
 //! * spreading support P points per dimension with half-width w = √(ηΛ/2)/ξ:
-//!   the truncated Gaussian tail is e^{−2ξ²w²/η} = e^{−Λ}; P = ⌈2w/h⌉ + 2.
+//!   the truncated Gaussian tail is e^{−2ξ²w²/η} = e^{−Λ}; P = ⌈2w/h⌉ + 2, placed
+//!   symmetrically about the particle (the nearest grid point to the support's centre), so
+//!   that it reaches at least (P − 2)h/2 ≥ w on both sides.
 //!
 //! The cut-off r_c itself is free: it trades real-space pairs against grid points. It is
 //! chosen by minimising a cost model (nanoseconds per pair and per grid point log n, estimated
@@ -25,8 +34,16 @@
 
 use glam::DVec3;
 
-/// Gaussian split between spreading/gathering and the middle kernel.
-pub(crate) const SPLIT: f64 = 0.6;
+/// Margin δ (in e-folds) of the spreading aliasing e^{−2η(1−η/2)Λ_g} below e^{−Λ}.
+pub(crate) fn alias_margin(lam: f64) -> f64 {
+    0.5 + 0.07 * lam
+}
+
+/// The Gaussian split η: 2η(1 − η/2)Λ_g = Λ + δ ([`alias_margin`]), at most 0.9.
+fn split(lam: f64, lam_g: f64) -> f64 {
+    let c = ((lam + alias_margin(lam)) / lam_g).min(0.99);
+    (1.0 - (1.0 - c).sqrt()).min(0.9)
+}
 
 /// Largest FFT length per side (memory: about 100 n³ bytes while preparing the kernel).
 pub const MAX_FFT: usize = 320;
@@ -54,6 +71,8 @@ pub(crate) struct Params {
     pub support: usize,
     /// Gaussian parameter of the middle kernel, ξ/√(1 − η) \[1/m\]
     pub alpha: f64,
+    /// Gaussian split η between spreading/gathering and the middle kernel
+    pub split: f64,
     /// grid points per dimension holding particles (the FFT grid is `fft_n` ≥ 2 `m`)
     pub m: usize,
     /// FFT length per dimension (zero padding to ≥ 2 m: aperiodic convolution)
@@ -116,6 +135,7 @@ impl Params {
             h: 0.0,
             support: 0,
             alpha: 0.0,
+            split: 0.0,
             m: 0,
             fft_n: 0,
             origin: lo,
@@ -129,7 +149,8 @@ impl Params {
         let (lr, lg, ls) = (lam + 1.5, lam + 1.5 * lam.ln() + 1.5, lam);
         let xi = lr.sqrt() / rc;
         let h = std::f64::consts::PI / (2.0 * xi * lg.sqrt());
-        let w = (SPLIT * ls / 2.0).sqrt() / xi;
+        let split = split(lam, lg);
+        let w = (split * ls / 2.0).sqrt() / xi;
         let support = (2.0 * w / h).ceil() as usize + 2;
         let margin = (support as f64 / 2.0 + 1.0) * h;
         let m = ((extent + 2.0 * margin) / h).ceil() as usize + 1;
@@ -139,7 +160,8 @@ impl Params {
             cutoff: rc,
             h,
             support,
-            alpha: xi / (1.0 - SPLIT).sqrt(),
+            alpha: xi / (1.0 - split).sqrt(),
+            split,
             m,
             fft_n: good_size(2 * m),
             origin: lo - DVec3::splat(margin),

@@ -22,7 +22,7 @@ use std::sync::{Arc, Mutex};
 
 use super::fft3::Fft3;
 use super::kernels::{smoothed_laplacian, wave_stokeslet};
-use super::params::{Params, SPLIT};
+use super::params::Params;
 
 /// Symmetric 3×3 kernel at one wavenumber: xx, yy, zz, xy, xz, yz (real: the sampled
 /// kernels are even).
@@ -131,7 +131,7 @@ impl Wave {
         let xi = params.xi;
         let fft = Fft3::new(n, m);
         // spreading Gaussian per axis: (2ξ²/πη)^{1/2} e^{−2ξ²d²/η}
-        let c_exp = 2.0 * xi * xi / SPLIT;
+        let c_exp = 2.0 * xi * xi / params.split;
         let c_norm = (c_exp / PI).sqrt();
         let mut start = Vec::with_capacity(positions.len());
         let mut weights = Vec::with_capacity(positions.len() * 3 * p);
@@ -139,7 +139,9 @@ impl Wave {
             let t = (*x - params.origin) / h;
             let mut s = [0usize; 3];
             for k in 0..3 {
-                let m0 = (t[k].floor() as i64 - (p as i64 - 1) / 2).clamp(0, (m - p) as i64);
+                // support centred on the particle: reaches ≥ (P − 2)h/2 on both sides
+                let m0 =
+                    ((t[k] - (p as f64 - 1.0) / 2.0 + 0.5).floor() as i64).clamp(0, (m - p) as i64);
                 s[k] = m0 as usize;
                 for q in 0..p {
                     let d = (t[k] - (m0 as usize + q) as f64) * h;
