@@ -71,7 +71,40 @@ pub fn pair_contact(
     h_j: f64,
     r_j: f64,
 ) -> PairContact {
-    let c = if h_i == 0.0 && h_j == 0.0 {
+    contact_from_closest(closest(u_i, h_i, r, u_j, h_j), u_i, r_i, u_j, r_j)
+}
+
+/// [`pair_contact`] when it overlaps, `None` when the closest points are certainly farther
+/// apart than r_i + r_j (the overlap would be negative): a squared-distance test before the
+/// square root and the contact frame. `Some` carries exactly [`pair_contact`]'s value.
+#[inline]
+pub fn pair_contact_if_close(
+    u_i: DVec3,
+    h_i: f64,
+    r_i: f64,
+    r: DVec3,
+    u_j: DVec3,
+    h_j: f64,
+    r_j: f64,
+) -> Option<PairContact> {
+    let c = closest(u_i, h_i, r, u_j, h_j);
+    let reach = r_i + r_j;
+    // margin: sqrt(k2) then exceeds r_i + r_j despite round-off, so the overlap is < 0
+    if c.k.length_squared() > reach * reach * (1.0 + 1e-12) {
+        return None;
+    }
+    Some(contact_from_closest(c, u_i, r_i, u_j, r_j))
+}
+
+#[inline]
+fn closest(
+    u_i: DVec3,
+    h_i: f64,
+    r: DVec3,
+    u_j: DVec3,
+    h_j: f64,
+) -> crate::geometry::SegmentClosest {
+    if h_i == 0.0 && h_j == 0.0 {
         crate::geometry::SegmentClosest {
             k: r,
             s: 0.0,
@@ -79,7 +112,17 @@ pub fn pair_contact(
         }
     } else {
         segment_closest(u_i, h_i, r, u_j, h_j)
-    };
+    }
+}
+
+#[inline]
+fn contact_from_closest(
+    c: crate::geometry::SegmentClosest,
+    u_i: DVec3,
+    r_i: f64,
+    u_j: DVec3,
+    r_j: f64,
+) -> PairContact {
     let d = c.k.length();
     let normal = if d > 1e-300 {
         c.k / d

@@ -33,12 +33,13 @@
 
 use glam::{DQuat, DVec3};
 
+use super::contact::pair_contact_if_close;
 use super::external::PackingKernels;
 use super::neighbour::NeighbourList;
 use super::removal::{RemovalOutcome, turn_bound};
 use super::sphere_pairs::{sphere_pair_forces, sphere_radii};
 use super::state::{BodyKind, PackingState};
-use super::walls::WallKind;
+use super::walls::{WallKind, WallPlane, planes};
 
 /// Iterations over which a stagnating energy ends the minimisation as failed.
 pub const STAGNATION_WINDOW: u64 = 2000;
@@ -102,7 +103,15 @@ pub fn overlap_forces(
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
     let radii = sphere_radii(state);
-    overlap_forces_with(state, list, radii.as_deref(), true, force, torque)
+    overlap_forces_with(
+        state,
+        list,
+        radii.as_deref(),
+        true,
+        &mut Vec::new(),
+        force,
+        torque,
+    )
 }
 
 /// [`overlap_forces`] by the generic contact route for every body (the reference of the
@@ -113,7 +122,7 @@ pub fn overlap_forces_generic(
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
-    overlap_forces_with(state, list, None, true, force, torque)
+    overlap_forces_with(state, list, None, true, &mut Vec::new(), force, torque)
 }
 
 /// [`overlap_forces`] with the sphere radii known (`Some` only when every body is a sphere);
@@ -123,6 +132,7 @@ fn overlap_forces_with(
     list: &mut NeighbourList,
     sphere_radii: Option<&[f64]>,
     with_energy: bool,
+    axes: &mut Vec<DVec3>,
     force: &mut [DVec3],
     torque: &mut [DVec3],
 ) -> (f64, f64, u64) {
@@ -134,11 +144,34 @@ fn overlap_forces_with(
     if let Some(radii) = sphere_radii {
         (max_overlap, energy) = sphere_pair_forces(state, radii, list.unique(), force, with_energy);
     } else {
+        // rods only: each axis rotated once per evaluation instead of twice per pair (the
+        // same values, so the same contacts bit for bit as `contact_warm`)
+        let rods = state.bodies.iter().all(|b| matches!(b.kind, BodyKind::Rod));
+        axes.clear();
+        if rods {
+            axes.extend((0..state.len()).map(|i| state.axis(i)));
+        }
         for idx in 0..list.unique().len() {
             let p = list.unique()[idx];
             let (i, j, k) = (p.i as usize, p.j as usize, p.k as usize);
             let shift = list.entry(k).shift(state.edges);
-            let c = state.contact_warm(i, j, shift, list.warm_mut(k));
+            let c = if rods {
+                let (bi, bj) = (&state.bodies[i], &state.bodies[j]);
+                match pair_contact_if_close(
+                    axes[i],
+                    bi.half_length,
+                    bi.radius,
+                    state.positions[j] + shift - state.positions[i],
+                    axes[j],
+                    bj.half_length,
+                    bj.radius,
+                ) {
+                    Some(c) => c,
+                    None => continue, // no overlap (and rods never fall back)
+                }
+            } else {
+                state.contact_warm(i, j, shift, list.warm_mut(k))
+            };
             fallbacks += c.fallback as u64;
             if c.overlap <= 0.0 {
                 continue;
@@ -158,7 +191,11 @@ fn overlap_forces_with(
         return (max_overlap, energy, fallbacks);
     }
     let mut walls = Vec::new();
+    let flat = planes(state.walls, state.edges);
     for i in 0..state.len() {
+        if far_from_flat_walls(state, &flat, i) {
+            continue; // no virtual rod, so no wall contact
+        }
         walls.clear();
         state.wall_contacts(i, 0.0, &mut walls);
         for c in walls.iter().filter(|c| c.overlap > 0.0) {
@@ -170,6 +207,20 @@ fn overlap_forces_with(
         }
     }
     (max_overlap, energy, fallbacks)
+}
+
+/// Whether rod or sphere `i` of a flat-walled container is farther than its radius (plus a
+/// round-off margin) from every wall at both end points, i.e. has no virtual rod (`flat` are
+/// the container's [`planes`]; empty for the cylinder, which is never skipped).
+fn far_from_flat_walls(state: &PackingState, flat: &[WallPlane], i: usize) -> bool {
+    let b = &state.bodies[i];
+    if flat.is_empty() || !matches!(b.kind, BodyKind::Rod) {
+        return false;
+    }
+    // an end point x +- h u is at least d(x) - h from a plane; lengths are / D <= 1000
+    let x = state.positions[i];
+    flat.iter()
+        .all(|p| p.distance(x) - b.half_length > b.radius + 1e-9)
 }
 
 /// Largest residual force or (projected) torque.
@@ -205,6 +256,7 @@ pub fn remove_overlaps_fire_with(
     let (kernel_scale, ext_max) = kernels.map_or((0.0, 0.0), |k| k.scale(state, tol));
     let kernels = kernels.filter(|_| kernel_scale > 0.0);
     let mut scratch = Vec::new();
+    let mut axes = Vec::new();
     let mut f = vec![DVec3::ZERO; n];
     let mut t = vec![DVec3::ZERO; n];
     let mut v = vec![DVec3::ZERO; n];
@@ -236,6 +288,7 @@ pub fn remove_overlaps_fire_with(
             list,
             radii.as_deref(),
             it % STAGNATION_WINDOW == 0,
+            &mut axes,
             &mut f,
             &mut t,
         );
@@ -379,6 +432,91 @@ mod tests {
         state.positions.push(DVec3::ONE);
         state.orientations.push(DQuat::IDENTITY);
         state
+    }
+
+    /// The reference of the rod fast path: every listed pair by `PackingState::contact`
+    /// (axes rotated per pair, the full contact frame) and every body's wall contacts.
+    fn reference_forces(
+        state: &PackingState,
+        list: &NeighbourList,
+    ) -> (Vec<DVec3>, Vec<DVec3>, f64, f64) {
+        let n = state.len();
+        let (mut f, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        let (mut max_overlap, mut energy): (f64, f64) = (0.0, 0.0);
+        let mut add = |i: usize, j: Option<usize>, c: crate::packing::contact::PairContact| {
+            if c.overlap <= 0.0 {
+                return;
+            }
+            max_overlap = max_overlap.max(c.overlap);
+            energy += 0.5 * c.overlap * c.overlap;
+            let fc = c.overlap * c.normal;
+            f[i] -= fc;
+            t[i] += (c.rc_i - 0.5 * c.overlap * c.normal).cross(-fc);
+            if let Some(j) = j {
+                f[j] += fc;
+                t[j] += (c.rc_j + 0.5 * c.overlap * c.normal).cross(fc);
+            }
+        };
+        for p in list.unique() {
+            let (i, j) = (p.i as usize, p.j as usize);
+            let shift = list.entry(p.k as usize).shift(state.edges);
+            add(i, Some(j), state.contact(i, j, shift));
+        }
+        let mut walls = Vec::new();
+        for i in 0..n {
+            walls.clear();
+            state.wall_contacts(i, 0.0, &mut walls);
+            for c in walls.iter() {
+                add(i, None, *c);
+            }
+        }
+        (f, t, max_overlap, energy)
+    }
+
+    #[test]
+    fn rod_forces_in_a_wedge_equal_the_per_pair_reference_bit_for_bit() {
+        use crate::packing::walls::wedge_edges;
+        use rand::{RngExt, SeedableRng};
+        let alpha = 0.5;
+        let mut state = PackingState::periodic_cube(1.0);
+        state.walls = WallKind::Wedge { alpha };
+        state.edges = wedge_edges(alpha, 12.0, 6.0);
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+        let rod = Shape::Spherocylinder {
+            radius: 0.5,
+            half_length: 1.0,
+        };
+        while state.len() < 60 {
+            let x = DVec3::new(
+                rng.random_range(0.0..12.0),
+                rng.random_range(0.0..6.0),
+                rng.random_range(0.0..6.0),
+            );
+            if x.y > x.x * alpha.tan() + 0.3 {
+                continue; // outside the slope (a little overlap with it is kept)
+            }
+            let axis = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            if axis.length() < 0.1 {
+                continue;
+            }
+            state.bodies.push(Body::from_shape(&rod, 1.0));
+            state.positions.push(x);
+            state
+                .orientations
+                .push(DQuat::from_rotation_arc(DVec3::Z, axis.normalize()));
+        }
+        let mut list = NeighbourList::new(0.1);
+        list.build(&mut state);
+        let (want_f, want_t, want_max, want_e) = reference_forces(&state, &list);
+        assert!(want_max > 0.0 && want_e > 0.0, "the test needs overlaps");
+        let (mut f, mut t) = (vec![DVec3::ZERO; 60], vec![DVec3::ZERO; 60]);
+        let (max_overlap, energy, fb) = overlap_forces(&state, &mut list, &mut f, &mut t);
+        assert_eq!((max_overlap, energy, fb), (want_max, want_e, 0));
+        assert_eq!((f, t), (want_f, want_t));
     }
 
     #[test]
