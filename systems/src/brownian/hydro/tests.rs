@@ -36,6 +36,18 @@ fn eq_6_10(r: DVec3, a: f64) -> DMat3 {
     (DMat3::IDENTITY * c1 + rr * c2) * mu0(a)
 }
 
+/// `n` equal spheres of radius `a` \[m\] placed at random (overlaps allowed) in a cube sized
+/// for a volume fraction of 1 %, as the timing and profile probes use them: positions, radii.
+pub(super) fn dilute_suspension(
+    rng: &mut Xoshiro256PlusPlus,
+    n: usize,
+    a: f64,
+) -> (Vec<DVec3>, Vec<f64>) {
+    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
+    let (pos, _) = random_config(rng, n, edge, false);
+    (pos, vec![a; n])
+}
+
 pub(super) fn random_config(
     rng: &mut Xoshiro256PlusPlus,
     n: usize,

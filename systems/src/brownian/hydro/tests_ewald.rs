@@ -5,7 +5,7 @@ use super::ewald::kernels::{
     SERIES_BELOW, far_rpy, real_laplacian, real_rpy, real_stokeslet, smoothed_laplacian,
     smoothed_stokeslet, wave_stokeslet,
 };
-use super::tests::{A, ETA, normals, random_config};
+use super::tests::{A, ETA, dilute_suspension, normals, random_config};
 use super::*;
 use glam::DVec3;
 use rand::SeedableRng;
@@ -403,10 +403,8 @@ fn step_timing() {
         (MobilityMethod::Cholesky, 1000),
     ];
     for &(method, n) in cases {
-        let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-        let (pos, _) = random_config(&mut rng, n, edge, false);
-        let radii = vec![a; n];
+        let (pos, radii) = dilute_suspension(&mut rng, n, a);
         let w = normals(&mut rng, n);
         let f: Vec<DVec3> = normals(&mut rng, n).iter().map(|v| *v * 1e-14).collect();
         let opts = MobilityOptions {
@@ -457,10 +455,8 @@ fn direct_product_timing() {
     // N = 1000 at φ = 0.01: stored pair blocks (Near with ξ = 0) against the streamed product,
     // each prepared once and applied 14 times (one step), interleaved 5 times
     let (n, a) = (1000, 75e-9);
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let f = flat(&normals(&mut rng, n));
     let params = Params::with_cutoff(1e-4, None, &pos, &radii);
     let mut v = vec![0.0; 3 * n];
@@ -494,10 +490,8 @@ fn direct_product_timing() {
 #[ignore = "profile probe (callgrind): N = 10^4 spectral Ewald, prepare + 2 products"]
 fn ewald_product_profile() {
     let (n, a) = (10_000, 75e-9);
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let f = flat(&normals(&mut rng, n));
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
     let mut v = vec![0.0; 3 * n];

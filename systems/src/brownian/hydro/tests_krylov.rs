@@ -1,7 +1,7 @@
 //! Tests and probes of the Lanczos square root ([`super::krylov`]).
 
 use super::ewald::SpectralEwald;
-use super::tests::{ETA, normals, random_config};
+use super::tests::{ETA, dilute_suspension, normals, random_config};
 use super::*;
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -22,10 +22,8 @@ fn lanczos_convergence_probe() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
     let a = 75e-9;
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let w = flat(&normals(&mut rng, n));
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
     let reach: f64 = std::env::var("PROBE_REACH")
@@ -190,10 +188,8 @@ fn preconditioned_noise_covariance_and_fewer_iterations() {
 fn product_parts_timing() {
     use std::time::Instant;
     let (n, a) = (10_000, 75e-9);
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let f = flat(&normals(&mut rng, n));
     let t = Instant::now();
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
@@ -248,10 +244,8 @@ fn cutoff_cost_probe() {
     // one step's cost (prepare with a cached kernel + 16 products) against the cut-off, N = 10⁴
     use std::time::Instant;
     let (n, a) = (10_000, 75e-9);
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let f = flat(&normals(&mut rng, n));
     let rc0 = SpectralEwald::new(&pos, &radii, ETA, 1e-4)
         .unwrap()
@@ -286,10 +280,8 @@ fn ewald_prepare_profile() {
     // the same configuration and tolerance as `ewald_product_profile`, without the products:
     // the difference of the two counts is the cost of two products
     let (n, a) = (10_000, 75e-9);
-    let edge = a * (n as f64 * 4.0 / 3.0 * std::f64::consts::PI / 0.01).cbrt();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, _) = random_config(&mut rng, n, edge, false);
-    let radii = vec![a; n];
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
     let _ = normals(&mut rng, n);
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
     eprintln!("{:?}", op.summary());
