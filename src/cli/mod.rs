@@ -89,6 +89,12 @@ enum Command {
         /// Worker threads (default: all cores; at most 1024).
         #[arg(long)]
         threads: Option<usize>,
+        /// How the step's systems are scheduled: `auto` (the pipeline's choice, else by the
+        /// scene's size), `single` (one system after the other; their per-particle loops still
+        /// use every thread) or `multi` (bevy's multi-threaded executor). All give bitwise the
+        /// same results.
+        #[arg(long, value_enum, default_value = "auto")]
+        executor: run::Executor,
         /// Memory budget [GiB] the scene's estimated memory must fit (default: 16 GiB or
         /// 3/4 of the machine's memory, whichever is smaller; or MAGSEP_MEMORY_BUDGET).
         #[arg(long, value_name = "GiB")]
@@ -256,6 +262,7 @@ pub fn main_with(ext: Extensions) -> i32 {
             seed,
             quiet,
             threads,
+            executor,
             memory_budget,
             force,
             set,
@@ -267,6 +274,7 @@ pub fn main_with(ext: Extensions) -> i32 {
                 seed,
                 quiet,
                 threads,
+                executor,
                 force,
                 memory_budget,
                 set,

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::overrides::{Override, apply_overrides};
-use crate::scene::{Progress, RunOptions, Scene, parse_scene};
+use crate::scene::{ExecutorChoice, Progress, RunOptions, Scene, parse_scene};
 use crate::sim::{SimError, StopFlag, run_scene};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -166,6 +166,28 @@ impl Progress for Bar {
     }
 }
 
+/// `magsep run --executor`: how the step's systems are scheduled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Executor {
+    /// The pipeline's choice, else single-threaded below 256 particles.
+    Auto,
+    /// One system after the other.
+    Single,
+    /// bevy's multi-threaded executor.
+    Multi,
+}
+
+impl Executor {
+    /// The driver's choice for this option.
+    pub fn choice(self) -> ExecutorChoice {
+        match self {
+            Self::Auto => ExecutorChoice::Auto,
+            Self::Single => ExecutorChoice::SingleThreaded,
+            Self::Multi => ExecutorChoice::MultiThreaded,
+        }
+    }
+}
+
 /// The options of `magsep run`.
 pub struct RunArgs {
     pub scene: PathBuf,
@@ -173,6 +195,7 @@ pub struct RunArgs {
     pub seed: Option<u64>,
     pub quiet: bool,
     pub threads: Option<usize>,
+    pub executor: Executor,
     pub force: bool,
     pub memory_budget: Option<f64>,
     /// `--set PATH=VALUE` overrides, in order.
@@ -187,6 +210,7 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         seed,
         quiet,
         threads,
+        executor,
         force,
         memory_budget,
         set,
@@ -206,6 +230,7 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         seed,
         record,
         single_threaded: single,
+        executor: executor.choice(),
         plugins: ext.plugins.clone(),
         stop: Some(stop),
         ..Default::default()

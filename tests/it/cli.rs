@@ -202,3 +202,32 @@ fn record_info_replay_truncation_and_determinism() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("junk.mcap"), "{}", stderr(&o));
 }
+
+#[test]
+fn every_executor_records_the_same_frames() {
+    let scene = write("exec.toml", GOOD);
+    let mut frames = Vec::new();
+    for executor in ["auto", "single", "multi"] {
+        let rec = tmp(&format!("exec_{executor}.mcap"));
+        let o = magsep(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--record",
+            rec.to_str().unwrap(),
+            "--quiet",
+            "--threads",
+            "2",
+            "--executor",
+            executor,
+            "--force",
+        ]);
+        assert!(o.status.success(), "{executor}: {}", stderr(&o));
+        frames.push(read_recording(&rec).unwrap().frames);
+    }
+    assert!(frames[0].len() >= 2);
+    assert_eq!(frames[0], frames[1], "auto and single differ");
+    assert_eq!(frames[0], frames[2], "auto and multi differ");
+    let o = magsep(&["run", scene.to_str().unwrap(), "--executor", "fast"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--executor"), "{}", stderr(&o));
+}
