@@ -194,17 +194,105 @@ pub(in crate::collision::engine) fn sweeps(
     (sweeps, residual)
 }
 
+/// Two halves of the particles (see the module header), kept between steps.
+#[derive(Debug, Clone, Default)]
+pub(in crate::collision::engine) struct Halves {
+    /// Per particle, its coordinate along the cut axis (wrapped) [m].
+    key: Vec<f64>,
+    /// Scratch for the median.
+    sample: Vec<f64>,
+    /// Per particle, its half (0 or 1).
+    pub(in crate::collision::engine) side: Vec<u8>,
+    /// Local particle index (half 0 first, each half in particle order) → particle index.
+    pub(in crate::collision::engine) perm: Vec<u32>,
+    /// Particle index → local index.
+    pub(in crate::collision::engine) local: Vec<u32>,
+    /// Particles in half 0.
+    pub(in crate::collision::engine) n0: usize,
+}
+
+impl Halves {
+    /// Splits the particles at `positions` across the axis of largest spread among those no
+    /// wall faces (all three if every axis is faced) at the median coordinate of the particles
+    /// `sample` (all particles if `None`).
+    pub(in crate::collision::engine) fn split(
+        &mut self,
+        positions: &[DVec3],
+        domain: &CollisionDomain,
+        sample: Option<&mut dyn Iterator<Item = usize>>,
+    ) {
+        let n = positions.len();
+        let faced = |a: usize| domain.planes.iter().any(|p| p.normal[a].abs() > 0.5);
+        let spread = |a: usize| {
+            let (lo, hi) =
+                positions
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                        let v = domain.wrap(*x)[a];
+                        (lo.min(v), hi.max(v))
+                    });
+            hi - lo
+        };
+        let free: Vec<usize> = (0..3).filter(|&a| !faced(a)).collect();
+        let axes = if free.is_empty() { vec![0, 1, 2] } else { free };
+        let axis = axes
+            .into_iter()
+            .map(|a| (a, spread(a)))
+            .fold((0, f64::NEG_INFINITY), |b, c| if c.1 > b.1 { c } else { b })
+            .0;
+        self.key.clear();
+        self.key
+            .extend(positions.iter().map(|x| domain.wrap(*x)[axis]));
+        self.sample.clear();
+        match sample {
+            Some(it) => self.sample.extend(it.map(|i| self.key[i])),
+            None => self.sample.extend_from_slice(&self.key),
+        }
+        let mid = self.sample.len() / 2;
+        let cut = if self.sample.is_empty() {
+            0.0
+        } else {
+            *self.sample.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        self.side.clear();
+        self.side.extend(
+            self.key
+                .iter()
+                .map(|&k| u8::from(k.total_cmp(&cut).is_ge())),
+        );
+        self.perm.clear();
+        self.local.clear();
+        self.local.resize(n, 0);
+        for half in 0..2 {
+            for i in 0..n {
+                if self.side[i] == half {
+                    self.local[i] = self.perm.len() as u32;
+                    self.perm.push(i as u32);
+                }
+            }
+            if half == 0 {
+                self.n0 = self.perm.len();
+            }
+        }
+    }
+
+    /// The block of the pair `(i, j)` (`j ≥ n`: a wall): the common half, or 2.
+    pub(in crate::collision::engine) fn block(&self, i: usize, j: usize) -> u8 {
+        if j >= self.side.len() || self.side[i] == self.side[j] {
+            self.side[i]
+        } else {
+            2
+        }
+    }
+}
+
 /// Scratch of [`layout`] and [`sweeps`] (kept between steps).
 #[derive(Debug, Clone, Default)]
 pub(in crate::collision::engine) struct Layout {
-    /// Per particle, its coordinate along the cut axis (wrapped) [m].
-    key: Vec<f64>,
-    /// Per particle, its half (0 or 1).
-    side: Vec<u8>,
+    /// The halves of the particles.
+    pub(in crate::collision::engine) halves: Halves,
     /// Local particle index → particle index.
     pub(in crate::collision::engine) perm: Vec<u32>,
-    /// Particle index → local index.
-    local: Vec<u32>,
     /// The contacts in block order, with local indices.
     pub(in crate::collision::engine) grouped: Vec<Contact>,
     /// Per grouped contact, its index in the caller's contacts.
@@ -214,9 +302,8 @@ pub(in crate::collision::engine) struct Layout {
 }
 
 /// Splits `contacts` (in sweep order; `n` particles at `positions`, walls `j ≥ n`) into blocks
-/// (see the module header): fills `s.grouped`, `s.src` and `s.perm` and returns the layout.
-/// The cut runs across the axis of largest spread among those no wall faces (all three if
-/// every axis is faced), at the median coordinate of the contacts' first particles.
+/// (see the module header; the cut at the median of the contacts' first particles): fills
+/// `s.grouped`, `s.src` and `s.perm` and returns the layout.
 pub(in crate::collision::engine) fn layout(
     contacts: &[Contact],
     positions: &[DVec3],
@@ -239,64 +326,25 @@ pub(in crate::collision::engine) fn layout(
             g1: 0,
         };
     }
-    let faced = |a: usize| domain.planes.iter().any(|p| p.normal[a].abs() > 0.5);
-    let spread = |a: usize| {
-        let (lo, hi) = positions
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                let v = domain.wrap(*x)[a];
-                (lo.min(v), hi.max(v))
-            });
-        hi - lo
-    };
-    let free: Vec<usize> = (0..3).filter(|&a| !faced(a)).collect();
-    let axes = if free.is_empty() { vec![0, 1, 2] } else { free };
-    let axis = axes
-        .into_iter()
-        .map(|a| (a, spread(a)))
-        .fold((0, f64::NEG_INFINITY), |b, c| if c.1 > b.1 { c } else { b })
-        .0;
-    s.key.clear();
-    s.key
-        .extend(positions.iter().map(|x| domain.wrap(*x)[axis]));
-    let mut firsts: Vec<f64> = contacts.iter().map(|c| s.key[c.i as usize]).collect();
-    let mid = m / 2;
-    firsts.select_nth_unstable_by(mid, f64::total_cmp);
-    let cut = firsts[mid];
-    s.side.clear();
-    s.side
-        .extend(s.key.iter().map(|&k| u8::from(k.total_cmp(&cut).is_ge())));
-    s.local.clear();
-    s.local.resize(n, 0);
-    for half in 0..2 {
-        for i in 0..n {
-            if s.side[i] == half {
-                s.local[i] = s.perm.len() as u32;
-                s.perm.push(i as u32);
-            }
-        }
-    }
-    let n0 = s.side.iter().filter(|&&h| h == 0).count();
-    let (side, local) = (&s.side, &s.local);
-    let block = |c: &Contact| {
-        let (i, j) = (c.i as usize, c.j as usize);
-        if j >= n || side[i] == side[j] {
-            side[i]
-        } else {
-            2
-        }
-    };
+    let h = &mut s.halves;
+    h.split(
+        positions,
+        domain,
+        Some(&mut contacts.iter().map(|c| c.i as usize)),
+    );
+    s.perm.extend_from_slice(&h.perm);
+    let n0 = h.n0;
     let mut counts = [0usize; 3];
     for b in 0..3u8 {
         for (k, c) in contacts.iter().enumerate() {
-            if block(c) != b {
+            if h.block(c.i as usize, c.j as usize) != b {
                 continue;
             }
             let shift = if b == 1 { n0 as u32 } else { 0 };
             let mut g = *c;
-            g.i = local[c.i as usize] - shift;
+            g.i = h.local[c.i as usize] - shift;
             if (c.j as usize) < n {
-                g.j = local[c.j as usize] - shift;
+                g.j = h.local[c.j as usize] - shift;
             }
             s.grouped.push(g);
             s.src.push(k as u32);
