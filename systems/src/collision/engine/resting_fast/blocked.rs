@@ -185,7 +185,7 @@ pub(in crate::collision::engine) fn sweeps(
             break;
         }
         let beta = norm / last_norm;
-        let restart = !(beta <= 1.0) || sweeps == 1;
+        let restart = beta.partial_cmp(&1.0).is_none_or(|o| o.is_gt()) || sweeps == 1;
         last_norm = norm;
         each_block(contacts, aux, bodies, blocks, false, &|c, a, b, _| {
             momentum(c, a, b, beta, restart)
