@@ -60,24 +60,23 @@
 //!   lab frame with the orientation at the event time.
 //! * The warm start keys contacts by particle index: call
 //!   [`CollisionEngine::clear_warm_start`] when the particle order or set changes.
-//! * Deterministic: single-threaded, fixed orders everywhere; the same input gives bitwise the
-//!   same output.
+//! * Deterministic: fixed orders everywhere; the NNCG resting solve and the projection of many
+//!   spheres run two blocks side by side, bitwise the same on any number of threads.
 //!
 //! **Spheroids** ([`SpheroidArrays`], thesis ch. 4): orientations rotate ballistically with the
 //! particle's local time; a pair with a non-round member uses the common-normal contact and the
-//! conservative-advancement TOI of [`super::spheroid`] (its approach filter is passed into the
-//! TOI as the minimum approach speed, so a slower touch does not hide a later faster one), walls
-//! the closed-form spheroid–plane gap; the resting solve and the projection use the contact
-//! normal and lever arms (translation only for the projection). The cell grid uses the bounding
-//! radii (a rotating body never leaves its bounding sphere). Overlaps of spheroids are reported
-//! relative to the sum of the bounding radii (`d_major` for equal discs). Without shapes the
-//! sphere path is unchanged (bitwise; checked against the sphere-only engine on a 300-sphere
-//! settling bed). For dense beds of flat discs the defaults are costly: a resting disc that rocks
-//! keeps approaching its neighbours at ~1e-4 m/s, above the default approach tolerance, and the
-//! default projection tolerance (1e-5 of `d_major`, 2e-4 of a 1:10 disc's half-thickness) is
-//! tighter than the TOI's penetration tolerance; `approach_tolerance = 1e-3` and
-//! `projection_tolerance = 1e-4` (the bed tests) cut the cost ~10× with overlaps still below
-//! 5e-4 `d_major` after the projection.
+//! conservative-advancement TOI of [`super::spheroid`] (its approach filter is passed into the TOI
+//! as the minimum approach speed, so a slower touch does not hide a later faster one), walls the
+//! closed-form spheroid–plane gap; the resting solve and the projection use the contact normal and
+//! lever arms (translation only for the projection). The cell grid uses the bounding radii.
+//! Overlaps of spheroids are reported relative to the sum of the bounding radii (`d_major` for
+//! equal discs). Without shapes the sphere path is unchanged (bitwise; checked against the
+//! sphere-only engine on a 300-sphere settling bed). For dense beds of flat discs the defaults are
+//! costly: a resting disc that rocks keeps approaching its neighbours at ~1e-4 m/s, above the
+//! default approach tolerance, and the default projection tolerance (1e-5 of `d_major`, 2e-4 of a
+//! 1:10 disc's half-thickness) is tighter than the TOI's penetration tolerance; `approach_tolerance
+//! = 1e-3` and `projection_tolerance = 1e-4` (the bed tests) cut the cost ~10× with overlaps still
+//! below 5e-4 `d_major` after the projection.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -90,7 +89,6 @@ use super::impulse::{CollisionLaw, FrictionRegime, RigidBody, collision_impulse}
 use super::restitution::{CollisionModel, Counterpart};
 use super::toi::{sphere_plane_toi, sphere_sphere_toi};
 use event::Event;
-
 mod event;
 mod projection;
 mod resting;
@@ -150,6 +148,8 @@ pub struct CollisionEngine {
     radius: Vec<f64>,
     /// Scratch of the fast kernels.
     fast: resting_fast::Scratch,
+    /// Scratch of the blocked projection.
+    proj: projection::blocked::Scratch,
     /// Use the plain reference kernels instead of the fast ones (tests compare the two).
     reference: bool,
 }

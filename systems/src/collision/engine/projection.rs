@@ -17,27 +17,40 @@ use glam::DVec3;
 
 use super::Sim;
 
+pub(super) mod blocked;
+
+/// The sweep budget of the projection: `sweep(fix, backward)` until no overlap exceeds `tol` or
+/// `max` sweeps are done, ending with a forward sweep (walls last) even one past the budget, and
+/// a last measuring sweep; returns the overlaps before, the sweeps and the overlaps after.
+fn budget(max: usize, tol: f64, mut sweep: impl FnMut(bool, bool) -> f64) -> (f64, usize, f64) {
+    let before = sweep(max > 0, false);
+    let mut worst = before;
+    let mut sweeps = usize::from(max > 0);
+    while sweeps < max && worst > tol {
+        worst = sweep(true, sweeps % 2 == 1);
+        sweeps += 1;
+    }
+    // end with a forward sweep (walls last), even one past the budget
+    if sweeps % 2 == 0 && worst > 0.0 {
+        sweep(true, false);
+        sweeps += 1;
+    }
+    let after = if max > 0 { sweep(false, false) } else { before };
+    (before, sweeps, after)
+}
+
 impl Sim<'_, '_> {
     /// Overlap-projection sweeps (see the module header); records the largest overlaps.
     pub(super) fn project(&mut self) {
-        self.reset_stamps();
-        let max = self.cfg.projection_sweeps as usize;
-        let before = self.sweep(max > 0, false);
-        let mut worst = before;
-        let mut sweeps = usize::from(max > 0);
-        while sweeps < max && worst > self.cfg.projection_tolerance {
-            worst = self.sweep(true, sweeps % 2 == 1);
-            sweeps += 1;
-        }
-        // end with a forward sweep (walls last), even one past the budget
-        if sweeps % 2 == 0 && worst > 0.0 {
-            self.sweep(true, false);
-            sweeps += 1;
-        }
-        let after = if max > 0 {
-            self.sweep(false, false)
+        let (before, sweeps, after) = if self.blocked_projection() {
+            self.project_blocked()
         } else {
-            before
+            self.reset_stamps();
+            let (max, tol) = (
+                self.cfg.projection_sweeps as usize,
+                self.cfg.projection_tolerance,
+            );
+            budget(max, tol, |fix, backward| self.sweep(fix, backward))
         };
         let st = &mut self.report.stats;
         st.max_overlap_before_projection = before;

@@ -21,7 +21,7 @@
 
 use glam::DVec3;
 
-use super::resting_fast::{self, Body};
+use super::resting_fast::{self, Body, blocked};
 use super::{CollisionEvent, FrictionRegime, InverseInertia, LastCollision, Partner, Sim};
 use crate::collision::impulse::RigidBody;
 use crate::collision::toi::ContactGeometry;
@@ -237,6 +237,9 @@ impl Sim<'_, '_> {
         tol: f64,
         mu: f64,
     ) -> (usize, f64) {
+        if self.cfg.nncg_sweeps > 0 {
+            return self.resting_nncg(contacts, inv_inertia, tol, mu);
+        }
         let n = self.n();
         let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
         bodies.clear();
@@ -262,6 +265,52 @@ impl Sim<'_, '_> {
         }
         self.eng.fast.bodies = bodies;
         self.eng.fast.scale = scale;
+        out
+    }
+
+    /// The NNCG solve on blocks of the contact graph ([`blocked`]) for isotropic inertias.
+    fn resting_nncg(
+        &mut self,
+        contacts: &mut [Contact],
+        inv_inertia: &[f64],
+        tol: f64,
+        mu: f64,
+    ) -> (usize, f64) {
+        let n = self.n();
+        let mut lay = std::mem::take(&mut self.eng.fast.blocked);
+        let blocks = blocked::layout(contacts, self.p.positions, self.domain, &mut lay);
+        let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
+        bodies.clear();
+        bodies.extend(lay.perm.iter().map(|&i| {
+            let i = i as usize;
+            Body {
+                v: self.p.velocities[i],
+                w: self.p.angular_velocities[i],
+                inv_mass: self.p.inv_masses[i],
+                inv_inertia: inv_inertia[i],
+            }
+        }));
+        let mut scale = std::mem::take(&mut self.eng.fast.scale);
+        scale.clear();
+        let r = &self.eng.radius;
+        scale.extend(lay.src.iter().map(|&k| {
+            let (i, j) = contacts[k as usize].ij();
+            tol * if j < n { r[i] + r[j] } else { 2.0 * r[i] }
+        }));
+        let max = self.cfg.nncg_sweeps as usize;
+        let (grouped, aux) = (&mut lay.grouped, &mut lay.aux);
+        let out = blocked::sweeps(grouped, &mut bodies, blocks, &scale, aux, mu, max);
+        for (g, &k) in lay.grouped.iter().zip(&lay.src) {
+            let c = &mut contacts[k as usize];
+            (c.lambda_n, c.lambda_t) = (g.lambda_n, g.lambda_t);
+        }
+        for (b, &i) in bodies.iter().zip(&lay.perm) {
+            self.p.velocities[i as usize] = b.v;
+            self.p.angular_velocities[i as usize] = b.w;
+        }
+        self.eng.fast.bodies = bodies;
+        self.eng.fast.scale = scale;
+        self.eng.fast.blocked = lay;
         out
     }
 

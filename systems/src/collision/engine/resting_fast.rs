@@ -11,6 +11,8 @@ use glam::DVec3;
 
 use super::resting::Contact;
 
+pub(super) mod blocked;
+
 /// Scratch buffers of the fast kernels (kept between steps).
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
@@ -26,6 +28,8 @@ pub(super) struct Scratch {
     pub(super) pair_apart: Vec<u64>,
     /// Per particle and wall, the stamp of the last evaluation that found them apart.
     pub(super) wall_apart: Vec<u64>,
+    /// Blocks and vectors of the NNCG solve.
+    pub(super) blocked: blocked::Layout,
 }
 
 /// One particle in the fast sweeps.

@@ -40,6 +40,12 @@ pub struct EngineConfig {
     /// Whether the resting-contact solve starts from the previous step's contact impulses.
     /// Default: true.
     pub warm_start: bool,
+    /// Maximum sweeps of the resting solve of spheres with nonsmooth nonlinear conjugate
+    /// gradients (projected Gauss–Seidel sweeps with momentum, on blocks of the contact graph
+    /// solved side by side); 0 selects the plain projected Gauss–Seidel sweeps, at most
+    /// `resting_sweeps`. Non-spherical particles always use the plain sweeps. Default: 35.
+    /// Range: ≥ 0.
+    pub nncg_sweeps: u32,
 }
 
 impl Default for EngineConfig {
@@ -54,6 +60,7 @@ impl Default for EngineConfig {
             resting_sweeps: 50,
             resting_tolerance: 1e-5,
             warm_start: true,
+            nncg_sweeps: 35,
         }
     }
 }
