@@ -1,6 +1,7 @@
 //! The resting solve for spheres as used by default: nonsmooth nonlinear conjugate gradients
-//! (NNCG, Silcowitz, Niebe & Erleben 2010: [Silcowitz2010] in docs/references.md) on projected Gauss–Seidel sweeps over two blocks of
-//! the contact graph that share no particle, solved side by side.
+//! (NNCG; Silcowitz, Niebe & Erleben 2010, `Silcowitz2010` in docs/references.md) on projected
+//! Gauss–Seidel sweeps over two blocks of the contact graph that share no particle, solved
+//! side by side.
 //!
 //! Blocks: with at least [`SPLIT_MIN_CONTACTS`] contacts, the particles are split at the median
 //! of their (wrapped) coordinate along a horizontal axis into two halves; the contacts within
