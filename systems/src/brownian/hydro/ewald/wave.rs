@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 
 use std::sync::{Arc, Mutex};
 
-use super::fft3::Fft3;
+use super::fft3::{ConvScratch, Fft3};
 use super::kernels::{smoothed_laplacian, wave_stokeslet};
 use super::params::Params;
 
@@ -44,6 +44,16 @@ pub(crate) struct Wave {
     /// Laplacian kernel for unequal radii, scaled
     kernel_l: Option<Arc<Vec<Sym>>>,
     radii_sq: Vec<f64>,
+    /// buffers reused by every product of this configuration
+    scratch: Mutex<WaveScratch>,
+}
+
+/// The grids and transform buffers of one product.
+#[derive(Debug, Default)]
+struct WaveScratch {
+    grid: Vec<f64>,
+    field: Vec<f64>,
+    conv: ConvScratch,
 }
 
 /// The kernel spectra of one grid: Stokeslet (or combined) and, for unequal radii, Laplacian.
@@ -209,6 +219,7 @@ impl Wave {
             kernel_s,
             kernel_l,
             radii_sq: radii.iter().map(|a| a * a).collect(),
+            scratch: Mutex::new(WaveScratch::default()),
         }
     }
 
@@ -217,9 +228,14 @@ impl Wave {
     /// the P·NF products (source × z weight) are formed once, then every (x, y) row of the
     /// support is one contiguous axpy of length P·NF (vectorised). Equal to the plain loop
     /// [`Wave::spread_reference`] up to rounding (tested).
-    fn spread<const NF: usize>(&self, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
+    fn spread<const NF: usize>(
+        &self,
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+        grid: &mut Vec<f64>,
+    ) {
         let (m, p) = (self.fft.m, self.support);
-        let mut grid = vec![0.0; m * m * m * NF];
+        grid.clear();
+        grid.resize(m * m * m * NF, 0.0);
         grid.par_chunks_mut(m * m * NF)
             .enumerate()
             .for_each(|(ix, plane)| {
@@ -246,7 +262,6 @@ impl Wave {
                     }
                 }
             });
-        grid
     }
 
     /// Gather the `NF` interleaved fields at particle `i`; `acc` is scratch of length P·NF.
@@ -372,93 +387,78 @@ impl Wave {
     /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
     pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
         let p = self.support;
+        // the buffers of the previous product (a fresh set if another product holds them)
+        let mut guard = self.scratch.try_lock().ok();
+        let mut fresh = WaveScratch::default();
+        let WaveScratch { grid, field, conv } = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => &mut fresh,
+        };
         if self.kernel_l.is_some() {
-            let grid = self.spread::<6>(&|i, c| self.source(f, i, c));
-            let field = self.convolve(&grid, 6);
+            self.spread::<6>(&|i, c| self.source(f, i, c), grid);
+            self.convolve_into(grid, 6, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 6 * p],
                 |acc, (i, o)| {
-                    let v = self.combine(&self.gather::<6>(&field, i, acc), i);
+                    let v = self.combine(&self.gather::<6>(field, i, acc), i);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
         } else {
-            let grid = self.spread::<3>(&|i, c| f[3 * i + c]);
-            let field = self.convolve(&grid, 3);
+            self.spread::<3>(&|i, c| f[3 * i + c], grid);
+            self.convolve_into(grid, 3, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 3 * p],
                 |acc, (i, o)| {
-                    let v = self.gather::<3>(&field, i, acc);
+                    let v = self.gather::<3>(field, i, acc);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
         }
     }
 
-    /// The grid convolution of the `nf` spread fields with the kernel(s): forward FFTs,
-    /// the 3×3 kernel products per wavenumber, inverse FFTs to the compact grid.
+    /// The grid convolution of the `nf` spread fields with the kernel(s) (allocating), for
+    /// the tests.
+    #[cfg(test)]
     fn convolve(&self, grid: &[f64], nf: usize) -> Vec<f64> {
-        let len = self.fft.spectrum_len();
-        let zero = Complex64::new(0.0, 0.0);
-        let mut spec: Vec<Vec<Complex64>> = (0..nf)
-            .map(|c| {
-                let mut s = vec![zero; len];
-                self.fft.forward(grid, nf, c, &mut s);
-                s
-            })
-            .collect();
-        const CHUNK: usize = 4096;
-        // nf is 3 without and 6 with the Laplacian kernel (by construction)
-        match (&self.kernel_l, &mut spec[..]) {
-            (None, [s0, s1, s2]) => {
-                (
-                    s0.par_chunks_mut(CHUNK),
-                    s1.par_chunks_mut(CHUNK),
-                    s2.par_chunks_mut(CHUNK),
-                    self.kernel_s.par_chunks(CHUNK),
-                )
-                    .into_par_iter()
-                    .for_each(|(a, b, c, k)| {
-                        for j in 0..a.len() {
-                            let v = sym_mul(&k[j], [a[j], b[j], c[j]]);
-                            (a[j], b[j], c[j]) = (v[0], v[1], v[2]);
-                        }
-                    });
-            }
-            (Some(kl), [s0, s1, s2, t0, t1, t2]) => {
-                (
-                    (
-                        s0.par_chunks_mut(CHUNK),
-                        s1.par_chunks_mut(CHUNK),
-                        s2.par_chunks_mut(CHUNK),
-                    ),
-                    (
-                        t0.par_chunks_mut(CHUNK),
-                        t1.par_chunks_mut(CHUNK),
-                        t2.par_chunks_mut(CHUNK),
-                    ),
-                    self.kernel_s.par_chunks(CHUNK),
-                    kl.par_chunks(CHUNK),
-                )
-                    .into_par_iter()
-                    .for_each(|((a, b, c), (d, e, g), ks, kl)| {
-                        for j in 0..a.len() {
-                            let fv = [a[j], b[j], c[j]];
-                            let u1 = sym_mul(&ks[j], fv);
-                            let u2 = sym_mul(&kl[j], [d[j], e[j], g[j]]);
-                            let u3 = sym_mul(&kl[j], fv);
-                            (a[j], b[j], c[j]) = (u1[0] + u2[0], u1[1] + u2[1], u1[2] + u2[2]);
-                            (d[j], e[j], g[j]) = (u3[0], u3[1], u3[2]);
-                        }
-                    });
-            }
-            _ => {}
-        }
-        let m = self.fft.m;
-        let mut field = vec![0.0; m * m * m * nf];
-        for (c, s) in spec.iter_mut().enumerate() {
-            self.fft.inverse(s, &mut field, nf, c);
-        }
+        let mut field = Vec::new();
+        self.convolve_into(grid, nf, &mut field, &mut ConvScratch::default());
         field
+    }
+
+    /// The grid convolution of the `nf` spread fields with the kernel(s) into `field`:
+    /// forward FFTs, the 3×3 kernel products per wavenumber, inverse FFTs to the compact
+    /// grid ([`Fft3::convolve`], the product fused with the x transforms of each kz plane).
+    fn convolve_into(&self, grid: &[f64], nf: usize, field: &mut Vec<f64>, conv: &mut ConvScratch) {
+        let (n, m) = (self.fft.n, self.fft.m);
+        let plane = n * n;
+        let ks = &self.kernel_s[..];
+        let mult = |kz: usize, chunks: &mut [Vec<Complex64>]| {
+            let ks = &ks[kz * plane..(kz + 1) * plane];
+            // nf is 3 without and 6 with the Laplacian kernel (by construction)
+            match (&self.kernel_l, chunks) {
+                (None, [a, b, c]) => {
+                    for (j, k) in ks.iter().enumerate() {
+                        let v = sym_mul(k, [a[j], b[j], c[j]]);
+                        (a[j], b[j], c[j]) = (v[0], v[1], v[2]);
+                    }
+                }
+                (Some(kl), [a, b, c, d, e, g]) => {
+                    let kl = &kl[kz * plane..(kz + 1) * plane];
+                    for (j, (ks, kl)) in ks.iter().zip(kl).enumerate() {
+                        let fv = [a[j], b[j], c[j]];
+                        let u1 = sym_mul(ks, fv);
+                        let u2 = sym_mul(kl, [d[j], e[j], g[j]]);
+                        let u3 = sym_mul(kl, fv);
+                        (a[j], b[j], c[j]) = (u1[0] + u2[0], u1[1] + u2[1], u1[2] + u2[2]);
+                        (d[j], e[j], g[j]) = (u3[0], u3[1], u3[2]);
+                    }
+                }
+                _ => {}
+            }
+        };
+        field.clear();
+        field.resize(m * m * m * nf, 0.0);
+        self.fft.convolve(grid, nf, &mult, field, conv);
     }
 }
