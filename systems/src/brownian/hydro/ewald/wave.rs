@@ -124,6 +124,18 @@ fn kernel_spectrum(
     out
 }
 
+/// True when the processor has AVX2 and FMA (the wide spreading and gathering).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 #[inline]
 fn sym_mul(k: &Sym, v: [Complex64; 3]) -> [Complex64; 3] {
     [
@@ -143,23 +155,26 @@ impl Wave {
         // spreading Gaussian per axis: (2ξ²/πη)^{1/2} e^{−2ξ²d²/η}
         let c_exp = 2.0 * xi * xi / params.split;
         let c_norm = (c_exp / PI).sqrt();
-        let mut start = Vec::with_capacity(positions.len());
-        let mut weights = Vec::with_capacity(positions.len() * 3 * p);
-        for x in positions {
-            let t = (*x - params.origin) / h;
-            let mut s = [0usize; 3];
-            for k in 0..3 {
-                // support centred on the particle: reaches ≥ (P − 2)h/2 on both sides
-                let m0 =
-                    ((t[k] - (p as f64 - 1.0) / 2.0 + 0.5).floor() as i64).clamp(0, (m - p) as i64);
-                s[k] = m0 as usize;
-                for q in 0..p {
-                    let d = (t[k] - (m0 as usize + q) as f64) * h;
-                    weights.push(c_norm * (-c_exp * d * d).exp());
+        let mut weights = vec![0.0; positions.len() * 3 * p];
+        let start: Vec<[usize; 3]> = positions
+            .par_iter()
+            .zip(weights.par_chunks_mut(3 * p))
+            .map(|(x, w)| {
+                let t = (*x - params.origin) / h;
+                let mut s = [0usize; 3];
+                for (k, wk) in w.chunks_exact_mut(p).enumerate() {
+                    // support centred on the particle: reaches ≥ (P − 2)h/2 on both sides
+                    let m0 = ((t[k] - (p as f64 - 1.0) / 2.0 + 0.5).floor() as i64)
+                        .clamp(0, (m - p) as i64);
+                    s[k] = m0 as usize;
+                    for (q, wq) in wk.iter_mut().enumerate() {
+                        let d = (t[k] - (m0 as usize + q) as f64) * h;
+                        *wq = c_norm * (-c_exp * d * d).exp();
+                    }
                 }
-            }
-            start.push(s);
-        }
+                s
+            })
+            .collect();
         let mut plane_members = vec![Vec::new(); m];
         for (i, s) in start.iter().enumerate() {
             for plane in plane_members.iter_mut().skip(s[0]).take(p) {
@@ -236,39 +251,110 @@ impl Wave {
         let (m, p) = (self.fft.m, self.support);
         grid.clear();
         grid.resize(m * m * m * NF, 0.0);
+        let avx2 = has_avx2();
         grid.par_chunks_mut(m * m * NF)
             .enumerate()
             .for_each(|(ix, plane)| {
                 let mut t = vec![0.0; p * NF];
-                for &i in &self.plane_members[ix] {
-                    let i = i as usize;
-                    let s = self.start[i];
-                    let w = &self.weights[3 * p * i..3 * p * (i + 1)];
-                    let wx = w[ix - s[0]];
-                    let mut q = [0.0; NF];
-                    for (c, qc) in q.iter_mut().enumerate() {
-                        *qc = src(i, c) * wx;
-                    }
-                    for (tb, wz) in t.chunks_exact_mut(NF).zip(&w[2 * p..3 * p]) {
-                        for (tc, qc) in tb.iter_mut().zip(&q) {
-                            *tc = qc * wz;
-                        }
-                    }
-                    for (a, wy) in w[p..2 * p].iter().enumerate() {
-                        let row0 = ((s[1] + a) * m + s[2]) * NF;
-                        for (o, tv) in plane[row0..row0 + p * NF].iter_mut().zip(&t) {
-                            *o += wy * tv;
-                        }
-                    }
+                #[cfg(target_arch = "x86_64")]
+                if avx2 {
+                    // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
+                    unsafe { self.spread_plane_avx2::<NF>(ix, plane, &mut t, src) };
+                    return;
                 }
+                let _ = avx2;
+                self.spread_plane::<NF>(ix, plane, &mut t, src);
             });
+    }
+
+    /// [`Wave::spread_plane`] compiled for AVX2 (the same operations on wider vectors,
+    /// bitwise the same result: no contraction to FMA without an explicit `mul_add`).
+    ///
+    /// # Safety
+    /// The processor must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn spread_plane_avx2<const NF: usize>(
+        &self,
+        ix: usize,
+        plane: &mut [f64],
+        t: &mut [f64],
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+    ) {
+        self.spread_plane::<NF>(ix, plane, t, src);
+    }
+
+    /// Adds every member particle's contribution to x-plane `ix`; `t` is scratch of P·NF.
+    #[inline(always)]
+    fn spread_plane<const NF: usize>(
+        &self,
+        ix: usize,
+        plane: &mut [f64],
+        t: &mut [f64],
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+    ) {
+        let (m, p) = (self.fft.m, self.support);
+        for &i in &self.plane_members[ix] {
+            let i = i as usize;
+            let s = self.start[i];
+            let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+            let wx = w[ix - s[0]];
+            let mut q = [0.0; NF];
+            for (c, qc) in q.iter_mut().enumerate() {
+                *qc = src(i, c) * wx;
+            }
+            for (tb, wz) in t.chunks_exact_mut(NF).zip(&w[2 * p..3 * p]) {
+                for (tc, qc) in tb.iter_mut().zip(&q) {
+                    *tc = qc * wz;
+                }
+            }
+            for (a, wy) in w[p..2 * p].iter().enumerate() {
+                let row0 = ((s[1] + a) * m + s[2]) * NF;
+                for (o, tv) in plane[row0..row0 + p * NF].iter_mut().zip(&*t) {
+                    *o += wy * tv;
+                }
+            }
+        }
     }
 
     /// Gather the `NF` interleaved fields at particle `i`; `acc` is scratch of length P·NF.
     /// Every (x, y) row of the support is one contiguous axpy of length P·NF into `acc`,
     /// reduced with the z weights at the end. Equal to [`Wave::gather_reference`] up to
     /// rounding (tested).
-    fn gather<const NF: usize>(&self, grid: &[f64], i: usize, acc: &mut [f64]) -> [f64; NF] {
+    fn gather<const NF: usize>(
+        &self,
+        grid: &[f64],
+        i: usize,
+        acc: &mut [f64],
+        avx2: bool,
+    ) -> [f64; NF] {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
+            return unsafe { self.gather_avx2::<NF>(grid, i, acc) };
+        }
+        let _ = avx2;
+        self.gather_plain::<NF>(grid, i, acc)
+    }
+
+    /// [`Wave::gather_plain`] compiled for AVX2 (bitwise the same result).
+    ///
+    /// # Safety
+    /// The processor must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn gather_avx2<const NF: usize>(
+        &self,
+        grid: &[f64],
+        i: usize,
+        acc: &mut [f64],
+    ) -> [f64; NF] {
+        self.gather_plain::<NF>(grid, i, acc)
+    }
+
+    /// The body of [`Wave::gather`].
+    #[inline(always)]
+    fn gather_plain<const NF: usize>(&self, grid: &[f64], i: usize, acc: &mut [f64]) -> [f64; NF] {
         let (m, p) = (self.fft.m, self.support);
         let s = self.start[i];
         let w = &self.weights[3 * p * i..3 * p * (i + 1)];
@@ -387,6 +473,7 @@ impl Wave {
     /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
     pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
         let p = self.support;
+        let avx2 = has_avx2();
         // the buffers of the previous product (a fresh set if another product holds them)
         let mut guard = self.scratch.try_lock().ok();
         let mut fresh = WaveScratch::default();
@@ -400,7 +487,7 @@ impl Wave {
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 6 * p],
                 |acc, (i, o)| {
-                    let v = self.combine(&self.gather::<6>(field, i, acc), i);
+                    let v = self.combine(&self.gather::<6>(field, i, acc, avx2), i);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
@@ -410,7 +497,7 @@ impl Wave {
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 3 * p],
                 |acc, (i, o)| {
-                    let v = self.gather::<3>(field, i, acc);
+                    let v = self.gather::<3>(field, i, acc, avx2);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
