@@ -150,20 +150,18 @@ impl Near {
     /// Rows `k ROWS ..` of the product into `o`.
     #[inline(always)]
     fn rows(&self, k: usize, o: &mut [f64], x: &[f64]) {
-        {
-            for (r, oi) in o.chunks_exact_mut(3).enumerate() {
-                let i = k * ROWS + r;
-                let mut acc = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]) * self.diag[i];
-                let xi = self.positions[i];
-                for b in self.start[i]..self.start[i + 1] {
-                    let j = self.cols[b] as usize;
-                    let (iso, f) = self.blocks[b];
-                    let d = xi - self.positions[j];
-                    let xj = DVec3::new(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
-                    acc += xj * iso + d * (f * d.dot(xj));
-                }
-                oi.copy_from_slice(&[acc.x, acc.y, acc.z]);
+        for (r, oi) in o.chunks_exact_mut(3).enumerate() {
+            let i = k * ROWS + r;
+            let mut acc = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]) * self.diag[i];
+            let xi = self.positions[i];
+            for b in self.start[i]..self.start[i + 1] {
+                let j = self.cols[b] as usize;
+                let (iso, f) = self.blocks[b];
+                let d = xi - self.positions[j];
+                let xj = DVec3::new(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
+                acc += xj * iso + d * (f * d.dot(xj));
             }
+            oi.copy_from_slice(&[acc.x, acc.y, acc.z]);
         }
     }
 }
