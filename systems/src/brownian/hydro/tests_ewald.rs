@@ -500,3 +500,35 @@ fn ewald_product_profile() {
     }
     eprintln!("{:?} {}", op.summary(), v[0]);
 }
+
+/// One BD step of the N = 10⁴ benchmark (prepare with the kernel cached, noise, drift).
+fn one_step(pos: &[DVec3], radii: &[f64], w: &[DVec3], f: &[DVec3], opts: MobilityOptions) {
+    let mob = Mobility::new_with(MobilityMethod::SpectralEwald, pos, radii, ETA, opts).unwrap();
+    let mut y = vec![DVec3::ZERO; pos.len()];
+    mob.noise(w, &mut y).unwrap();
+    mob.apply(f, &mut y);
+    eprintln!(
+        "krylov its {}, {:?}",
+        mob.krylov_iterations(),
+        mob.ewald_summary()
+    );
+}
+
+#[test]
+#[ignore = "profile probe (callgrind): ewald_prepare_profile + one N = 10^4 step, kernel cached"]
+fn ewald_step_profile() {
+    // the instruction count minus that of `ewald_prepare_profile` (the same set-up) is one step
+    let (n, a) = (10_000, 75e-9);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
+    let w = normals(&mut rng, n);
+    let f: Vec<DVec3> = normals(&mut rng, n).iter().map(|v| *v * 1e-14).collect();
+    let opts = MobilityOptions {
+        krylov_tolerance: 1e-3,
+        ewald_tolerance: 1e-4,
+        ..MobilityOptions::default()
+    };
+    // warms the kernel cache (a simulation computes it once)
+    let _ = SpectralEwald::new(&pos, &radii, ETA, opts.ewald_tolerance).unwrap();
+    one_step(&pos, &radii, &w, &f, opts);
+}

@@ -152,7 +152,10 @@ impl Params {
         let split = split(lam, lg);
         let w = (split * ls / 2.0).sqrt() / xi;
         let support = (2.0 * w / h).ceil() as usize + 2;
-        let margin = (support as f64 / 2.0 + 1.0) * h;
+        // a support starting at ⌊t − P/2 + 1⌋ (t the position in grid units from the origin)
+        // needs t ≥ P/2 − 1 and m ≥ t + P/2 + 1: margin P/2 (one point spare below) and
+        // m = ⌈extent/h + P⌉ + 1 (the smallest grid, hence the smallest FFT length)
+        let margin = support as f64 / 2.0 * h;
         let m = ((extent + 2.0 * margin) / h).ceil() as usize + 1;
         Self {
             tolerance,
@@ -242,5 +245,50 @@ impl Params {
             rc *= 1.25;
         }
         best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every particle's centred support (first index ⌊t − (P − 1)/2 + 0.5⌋, as `wave`
+    /// places it) lies inside the m³ grid without clamping, for the corners of the
+    /// configuration, at several tolerances and cut-offs.
+    #[test]
+    fn every_support_fits_the_grid_unclamped() {
+        let a = 1e-7;
+        let mut positions: Vec<DVec3> = (0..200)
+            .map(|k| {
+                let u = |s: usize| ((k * s + 17) % 97) as f64 / 96.0;
+                DVec3::new(u(31), u(57), u(73)) * 40.0 * a
+            })
+            .collect();
+        positions.push(DVec3::ZERO);
+        positions.push(DVec3::splat(40.0 * a));
+        let radii = vec![a; positions.len()];
+        let mut checked = 0;
+        for tol in [1e-2, 1e-4, 1e-6, 1e-10] {
+            for rc in [3.0 * a, 5.0 * a, 9.0 * a] {
+                let p = Params::with_cutoff(tol, Some(rc), &positions, &radii);
+                assert!(!p.is_direct());
+                let s = p.support as f64;
+                for x in &positions {
+                    let t = (*x - p.origin) / p.h;
+                    for k in 0..3 {
+                        let m0 = (t[k] - (s - 1.0) / 2.0 + 0.5).floor();
+                        assert!(m0 >= 0.0, "tol {tol} rc {rc}: start {m0}");
+                        assert!(
+                            m0 + s <= p.m as f64,
+                            "tol {tol} rc {rc}: {m0} + {s} > {}",
+                            p.m
+                        );
+                        checked += 1;
+                    }
+                }
+                assert!(p.fft_n >= 2 * p.m);
+            }
+        }
+        assert_eq!(checked, 4 * 3 * 202 * 3);
     }
 }

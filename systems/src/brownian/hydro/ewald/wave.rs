@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 
 use std::sync::{Arc, Mutex};
 
-use super::fft3::Fft3;
+use super::fft3::{ConvScratch, Fft3};
 use super::kernels::{smoothed_laplacian, wave_stokeslet};
 use super::params::Params;
 
@@ -44,6 +44,16 @@ pub(crate) struct Wave {
     /// Laplacian kernel for unequal radii, scaled
     kernel_l: Option<Arc<Vec<Sym>>>,
     radii_sq: Vec<f64>,
+    /// buffers reused by every product of this configuration
+    scratch: Mutex<WaveScratch>,
+}
+
+/// The grids and transform buffers of one product.
+#[derive(Debug, Default)]
+struct WaveScratch {
+    grid: Vec<f64>,
+    field: Vec<f64>,
+    conv: ConvScratch,
 }
 
 /// The kernel spectra of one grid: Stokeslet (or combined) and, for unequal radii, Laplacian.
@@ -114,6 +124,18 @@ fn kernel_spectrum(
     out
 }
 
+/// True when the processor has AVX2 and FMA (the wide spreading and gathering).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 #[inline]
 fn sym_mul(k: &Sym, v: [Complex64; 3]) -> [Complex64; 3] {
     [
@@ -133,23 +155,26 @@ impl Wave {
         // spreading Gaussian per axis: (2ξ²/πη)^{1/2} e^{−2ξ²d²/η}
         let c_exp = 2.0 * xi * xi / params.split;
         let c_norm = (c_exp / PI).sqrt();
-        let mut start = Vec::with_capacity(positions.len());
-        let mut weights = Vec::with_capacity(positions.len() * 3 * p);
-        for x in positions {
-            let t = (*x - params.origin) / h;
-            let mut s = [0usize; 3];
-            for k in 0..3 {
-                // support centred on the particle: reaches ≥ (P − 2)h/2 on both sides
-                let m0 =
-                    ((t[k] - (p as f64 - 1.0) / 2.0 + 0.5).floor() as i64).clamp(0, (m - p) as i64);
-                s[k] = m0 as usize;
-                for q in 0..p {
-                    let d = (t[k] - (m0 as usize + q) as f64) * h;
-                    weights.push(c_norm * (-c_exp * d * d).exp());
+        let mut weights = vec![0.0; positions.len() * 3 * p];
+        let start: Vec<[usize; 3]> = positions
+            .par_iter()
+            .zip(weights.par_chunks_mut(3 * p))
+            .map(|(x, w)| {
+                let t = (*x - params.origin) / h;
+                let mut s = [0usize; 3];
+                for (k, wk) in w.chunks_exact_mut(p).enumerate() {
+                    // support centred on the particle: reaches ≥ (P − 2)h/2 on both sides
+                    let m0 = ((t[k] - (p as f64 - 1.0) / 2.0 + 0.5).floor() as i64)
+                        .clamp(0, (m - p) as i64);
+                    s[k] = m0 as usize;
+                    for (q, wq) in wk.iter_mut().enumerate() {
+                        let d = (t[k] - (m0 as usize + q) as f64) * h;
+                        *wq = c_norm * (-c_exp * d * d).exp();
+                    }
                 }
-            }
-            start.push(s);
-        }
+                s
+            })
+            .collect();
         let mut plane_members = vec![Vec::new(); m];
         for (i, s) in start.iter().enumerate() {
             for plane in plane_members.iter_mut().skip(s[0]).take(p) {
@@ -209,6 +234,7 @@ impl Wave {
             kernel_s,
             kernel_l,
             radii_sq: radii.iter().map(|a| a * a).collect(),
+            scratch: Mutex::new(WaveScratch::default()),
         }
     }
 
@@ -217,43 +243,118 @@ impl Wave {
     /// the P·NF products (source × z weight) are formed once, then every (x, y) row of the
     /// support is one contiguous axpy of length P·NF (vectorised). Equal to the plain loop
     /// [`Wave::spread_reference`] up to rounding (tested).
-    fn spread<const NF: usize>(&self, src: &(dyn Fn(usize, usize) -> f64 + Sync)) -> Vec<f64> {
+    fn spread<const NF: usize>(
+        &self,
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+        grid: &mut Vec<f64>,
+    ) {
         let (m, p) = (self.fft.m, self.support);
-        let mut grid = vec![0.0; m * m * m * NF];
+        grid.clear();
+        grid.resize(m * m * m * NF, 0.0);
+        let avx2 = has_avx2();
         grid.par_chunks_mut(m * m * NF)
             .enumerate()
             .for_each(|(ix, plane)| {
                 let mut t = vec![0.0; p * NF];
-                for &i in &self.plane_members[ix] {
-                    let i = i as usize;
-                    let s = self.start[i];
-                    let w = &self.weights[3 * p * i..3 * p * (i + 1)];
-                    let wx = w[ix - s[0]];
-                    let mut q = [0.0; NF];
-                    for (c, qc) in q.iter_mut().enumerate() {
-                        *qc = src(i, c) * wx;
-                    }
-                    for (tb, wz) in t.chunks_exact_mut(NF).zip(&w[2 * p..3 * p]) {
-                        for (tc, qc) in tb.iter_mut().zip(&q) {
-                            *tc = qc * wz;
-                        }
-                    }
-                    for (a, wy) in w[p..2 * p].iter().enumerate() {
-                        let row0 = ((s[1] + a) * m + s[2]) * NF;
-                        for (o, tv) in plane[row0..row0 + p * NF].iter_mut().zip(&t) {
-                            *o += wy * tv;
-                        }
-                    }
+                #[cfg(target_arch = "x86_64")]
+                if avx2 {
+                    // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
+                    unsafe { self.spread_plane_avx2::<NF>(ix, plane, &mut t, src) };
+                    return;
                 }
+                let _ = avx2;
+                self.spread_plane::<NF>(ix, plane, &mut t, src);
             });
-        grid
+    }
+
+    /// [`Wave::spread_plane`] compiled for AVX2 (the same operations on wider vectors,
+    /// bitwise the same result: no contraction to FMA without an explicit `mul_add`).
+    ///
+    /// # Safety
+    /// The processor must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn spread_plane_avx2<const NF: usize>(
+        &self,
+        ix: usize,
+        plane: &mut [f64],
+        t: &mut [f64],
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+    ) {
+        self.spread_plane::<NF>(ix, plane, t, src);
+    }
+
+    /// Adds every member particle's contribution to x-plane `ix`; `t` is scratch of P·NF.
+    #[inline(always)]
+    fn spread_plane<const NF: usize>(
+        &self,
+        ix: usize,
+        plane: &mut [f64],
+        t: &mut [f64],
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+    ) {
+        let (m, p) = (self.fft.m, self.support);
+        for &i in &self.plane_members[ix] {
+            let i = i as usize;
+            let s = self.start[i];
+            let w = &self.weights[3 * p * i..3 * p * (i + 1)];
+            let wx = w[ix - s[0]];
+            let mut q = [0.0; NF];
+            for (c, qc) in q.iter_mut().enumerate() {
+                *qc = src(i, c) * wx;
+            }
+            for (tb, wz) in t.chunks_exact_mut(NF).zip(&w[2 * p..3 * p]) {
+                for (tc, qc) in tb.iter_mut().zip(&q) {
+                    *tc = qc * wz;
+                }
+            }
+            for (a, wy) in w[p..2 * p].iter().enumerate() {
+                let row0 = ((s[1] + a) * m + s[2]) * NF;
+                for (o, tv) in plane[row0..row0 + p * NF].iter_mut().zip(&*t) {
+                    *o += wy * tv;
+                }
+            }
+        }
     }
 
     /// Gather the `NF` interleaved fields at particle `i`; `acc` is scratch of length P·NF.
     /// Every (x, y) row of the support is one contiguous axpy of length P·NF into `acc`,
     /// reduced with the z weights at the end. Equal to [`Wave::gather_reference`] up to
     /// rounding (tested).
-    fn gather<const NF: usize>(&self, grid: &[f64], i: usize, acc: &mut [f64]) -> [f64; NF] {
+    fn gather<const NF: usize>(
+        &self,
+        grid: &[f64],
+        i: usize,
+        acc: &mut [f64],
+        avx2: bool,
+    ) -> [f64; NF] {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
+            return unsafe { self.gather_avx2::<NF>(grid, i, acc) };
+        }
+        let _ = avx2;
+        self.gather_plain::<NF>(grid, i, acc)
+    }
+
+    /// [`Wave::gather_plain`] compiled for AVX2 (bitwise the same result).
+    ///
+    /// # Safety
+    /// The processor must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn gather_avx2<const NF: usize>(
+        &self,
+        grid: &[f64],
+        i: usize,
+        acc: &mut [f64],
+    ) -> [f64; NF] {
+        self.gather_plain::<NF>(grid, i, acc)
+    }
+
+    /// The body of [`Wave::gather`].
+    #[inline(always)]
+    fn gather_plain<const NF: usize>(&self, grid: &[f64], i: usize, acc: &mut [f64]) -> [f64; NF] {
         let (m, p) = (self.fft.m, self.support);
         let s = self.start[i];
         let w = &self.weights[3 * p * i..3 * p * (i + 1)];
@@ -372,93 +473,79 @@ impl Wave {
     /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
     pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
         let p = self.support;
+        let avx2 = has_avx2();
+        // the buffers of the previous product (a fresh set if another product holds them)
+        let mut guard = self.scratch.try_lock().ok();
+        let mut fresh = WaveScratch::default();
+        let WaveScratch { grid, field, conv } = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => &mut fresh,
+        };
         if self.kernel_l.is_some() {
-            let grid = self.spread::<6>(&|i, c| self.source(f, i, c));
-            let field = self.convolve(&grid, 6);
+            self.spread::<6>(&|i, c| self.source(f, i, c), grid);
+            self.convolve_into(grid, 6, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 6 * p],
                 |acc, (i, o)| {
-                    let v = self.combine(&self.gather::<6>(&field, i, acc), i);
+                    let v = self.combine(&self.gather::<6>(field, i, acc, avx2), i);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
         } else {
-            let grid = self.spread::<3>(&|i, c| f[3 * i + c]);
-            let field = self.convolve(&grid, 3);
+            self.spread::<3>(&|i, c| f[3 * i + c], grid);
+            self.convolve_into(grid, 3, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 3 * p],
                 |acc, (i, o)| {
-                    let v = self.gather::<3>(&field, i, acc);
+                    let v = self.gather::<3>(field, i, acc, avx2);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
         }
     }
 
-    /// The grid convolution of the `nf` spread fields with the kernel(s): forward FFTs,
-    /// the 3×3 kernel products per wavenumber, inverse FFTs to the compact grid.
+    /// The grid convolution of the `nf` spread fields with the kernel(s) (allocating), for
+    /// the tests.
+    #[cfg(test)]
     fn convolve(&self, grid: &[f64], nf: usize) -> Vec<f64> {
-        let len = self.fft.spectrum_len();
-        let zero = Complex64::new(0.0, 0.0);
-        let mut spec: Vec<Vec<Complex64>> = (0..nf)
-            .map(|c| {
-                let mut s = vec![zero; len];
-                self.fft.forward(grid, nf, c, &mut s);
-                s
-            })
-            .collect();
-        const CHUNK: usize = 4096;
-        // nf is 3 without and 6 with the Laplacian kernel (by construction)
-        match (&self.kernel_l, &mut spec[..]) {
-            (None, [s0, s1, s2]) => {
-                (
-                    s0.par_chunks_mut(CHUNK),
-                    s1.par_chunks_mut(CHUNK),
-                    s2.par_chunks_mut(CHUNK),
-                    self.kernel_s.par_chunks(CHUNK),
-                )
-                    .into_par_iter()
-                    .for_each(|(a, b, c, k)| {
-                        for j in 0..a.len() {
-                            let v = sym_mul(&k[j], [a[j], b[j], c[j]]);
-                            (a[j], b[j], c[j]) = (v[0], v[1], v[2]);
-                        }
-                    });
-            }
-            (Some(kl), [s0, s1, s2, t0, t1, t2]) => {
-                (
-                    (
-                        s0.par_chunks_mut(CHUNK),
-                        s1.par_chunks_mut(CHUNK),
-                        s2.par_chunks_mut(CHUNK),
-                    ),
-                    (
-                        t0.par_chunks_mut(CHUNK),
-                        t1.par_chunks_mut(CHUNK),
-                        t2.par_chunks_mut(CHUNK),
-                    ),
-                    self.kernel_s.par_chunks(CHUNK),
-                    kl.par_chunks(CHUNK),
-                )
-                    .into_par_iter()
-                    .for_each(|((a, b, c), (d, e, g), ks, kl)| {
-                        for j in 0..a.len() {
-                            let fv = [a[j], b[j], c[j]];
-                            let u1 = sym_mul(&ks[j], fv);
-                            let u2 = sym_mul(&kl[j], [d[j], e[j], g[j]]);
-                            let u3 = sym_mul(&kl[j], fv);
-                            (a[j], b[j], c[j]) = (u1[0] + u2[0], u1[1] + u2[1], u1[2] + u2[2]);
-                            (d[j], e[j], g[j]) = (u3[0], u3[1], u3[2]);
-                        }
-                    });
-            }
-            _ => {}
-        }
-        let m = self.fft.m;
-        let mut field = vec![0.0; m * m * m * nf];
-        for (c, s) in spec.iter_mut().enumerate() {
-            self.fft.inverse(s, &mut field, nf, c);
-        }
+        let mut field = Vec::new();
+        self.convolve_into(grid, nf, &mut field, &mut ConvScratch::default());
         field
+    }
+
+    /// The grid convolution of the `nf` spread fields with the kernel(s) into `field`:
+    /// forward FFTs, the 3×3 kernel products per wavenumber, inverse FFTs to the compact
+    /// grid ([`Fft3::convolve`], the product fused with the x transforms of each kz plane).
+    fn convolve_into(&self, grid: &[f64], nf: usize, field: &mut Vec<f64>, conv: &mut ConvScratch) {
+        let (n, m) = (self.fft.n, self.fft.m);
+        let plane = n * n;
+        let ks = &self.kernel_s[..];
+        let mult = |kz: usize, chunks: &mut [Vec<Complex64>]| {
+            let ks = &ks[kz * plane..(kz + 1) * plane];
+            // nf is 3 without and 6 with the Laplacian kernel (by construction)
+            match (&self.kernel_l, chunks) {
+                (None, [a, b, c]) => {
+                    for (j, k) in ks.iter().enumerate() {
+                        let v = sym_mul(k, [a[j], b[j], c[j]]);
+                        (a[j], b[j], c[j]) = (v[0], v[1], v[2]);
+                    }
+                }
+                (Some(kl), [a, b, c, d, e, g]) => {
+                    let kl = &kl[kz * plane..(kz + 1) * plane];
+                    for (j, (ks, kl)) in ks.iter().zip(kl).enumerate() {
+                        let fv = [a[j], b[j], c[j]];
+                        let u1 = sym_mul(ks, fv);
+                        let u2 = sym_mul(kl, [d[j], e[j], g[j]]);
+                        let u3 = sym_mul(kl, fv);
+                        (a[j], b[j], c[j]) = (u1[0] + u2[0], u1[1] + u2[1], u1[2] + u2[2]);
+                        (d[j], e[j], g[j]) = (u3[0], u3[1], u3[2]);
+                    }
+                }
+                _ => {}
+            }
+        };
+        field.clear();
+        field.resize(m * m * m * nf, 0.0);
+        self.fft.convolve(grid, nf, &mult, field, conv);
     }
 }
