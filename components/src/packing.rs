@@ -23,8 +23,8 @@ pub enum VolumeStepRule {
     /// The thesis's rule: a constant step, halved after a failed step (revert).
     Fixed,
     /// A step proportional to the free volume, grown while compressions need no overlap
-    /// removal, halved after failures (and, with FIRE, when removal gets expensive); ends with
-    /// the same finest step and the same failure criterion as `Fixed`.
+    /// removal and shrunk when removal gets expensive; ends with the same finest step and the
+    /// same failure criterion as `Fixed`.
     Adaptive,
 }
 

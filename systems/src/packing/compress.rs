@@ -9,13 +9,9 @@
 //! * `Fixed` (the thesis): dV constant; after a failure dV /= 2; the run stops at the failure
 //!   that follows `step_halvings` halvings, i.e. a failure at dV_min = dV_0 / 2^h.
 //! * `Adaptive` (default): dV = f * V_free (V_free = V_box - V_particles), clamped to at least
-//!   dV_min. While steps need no overlap removal at all, f doubles (up to 1/4); after a
-//!   failure f halves and never grows again. With FIRE, f also halves when a step spends more
-//!   than a quarter of the budget and dV > dV_0. The single-particle rules (revised, original)
-//!   are refined by failures alone, as the thesis's fixed rule: their removal cost grows
-//!   sublinearly with dV (750 superballs: moves ~ dV^0.25 at phi 0.3, ~ dV^0.75 near
-//!   jamming), so the largest step that succeeds costs the fewest moves per unit of volume,
-//!   and a failure (one budget) is rarer than the extra moves of many smaller steps. It stops on a failure at dV_min: the same final criterion as `Fixed`, so
+//!   dV_min. While steps need no overlap removal at all, f doubles (up to 1/4); when a step
+//!   spends more than a quarter of the budget and dV > dV_0, f halves; after a failure f halves
+//!   and never grows again. It stops on a failure at dV_min: the same final criterion as `Fixed`, so
 //!   both rules end in statistically the same state (see `magsep chart packing`), but the
 //!   adaptive rule crosses the dilute regime in tens instead of tens of thousands of steps.
 
@@ -144,15 +140,10 @@ pub fn settle_step(
         if p.step_rule == VolumeStepRule::Adaptive {
             if out.attempts == 0 && st.may_grow {
                 st.adaptive_fraction = (st.adaptive_fraction * 2.0).min(0.25);
-            } else if p.rule == MoveRule::Fire
-                && out.attempts > p.max_attempts / 4
-                && dv > p.volume_step
-            {
-                // FIRE: expensive steps shrink the step down to the fixed rule's dV_0 only;
-                // below it only failures refine it (as in the thesis). The single-particle
-                // rules are refined by failures alone: their removal cost grows sublinearly
-                // with dV (moves ~ dV^0.25 at phi 0.3, ~ dV^0.75 near jamming), so a
-                // smaller step costs more moves per unit of compression
+            } else if out.attempts > p.max_attempts / 4 && dv > p.volume_step {
+                // expensive steps shrink the step down to the fixed rule's dV_0 only: below
+                // it only failures refine it (as in the thesis); the cost of a removal grows
+                // only slowly with dV, so smaller steps cost more per unit of compression
                 st.adaptive_fraction *= 0.5;
             }
         }
@@ -321,11 +312,8 @@ mod tests {
     }
 
     #[test]
-    fn expensive_steps_shrink_the_fire_step_only_above_dv0() {
-        let p = DriverParams {
-            rule: MoveRule::Fire,
-            ..params()
-        };
+    fn expensive_steps_shrink_the_adaptive_step_only_above_dv0() {
+        let p = params();
         let mut st = status(&p);
         settle_step(&p, &mut st, 0.2, success(300), || {});
         assert_eq!(st.adaptive_fraction, 0.005, "dV > dV_0: halved");
@@ -334,25 +322,5 @@ mod tests {
         settle_step(&p, &mut st, 0.2, success(200), || {});
         assert_eq!(st.adaptive_fraction, 0.005, "cheap step: kept");
         assert_eq!(st.compression_steps, 3);
-    }
-
-    #[test]
-    fn single_particle_rules_refine_the_adaptive_step_only_on_failures() {
-        let p = params();
-        let mut st = status(&p);
-        settle_step(&p, &mut st, 0.2, success(900), || {});
-        assert_eq!(st.adaptive_fraction, 0.01, "expensive success: kept");
-        let fail = RemovalOutcome {
-            success: false,
-            ..success(1000)
-        };
-        let mut restored = false;
-        settle_step(&p, &mut st, 0.2, fail, || restored = true);
-        assert!(restored);
-        assert_eq!(st.adaptive_fraction, 0.005, "failure: halved");
-        assert_eq!(st.stopped, None);
-        // a failure at the finest step ends the run as with the fixed rule
-        settle_step(&p, &mut st, p.min_volume_step(), fail, || {});
-        assert_eq!(st.stopped, Some(StopReason::Jammed));
     }
 }
