@@ -56,6 +56,17 @@ impl Contact {
     fn ij(&self) -> (usize, usize) {
         (self.i as usize, self.j as usize)
     }
+
+    /// The residual scale of this contact [m/s per unit of `tol`]: `tol` times the summed
+    /// radii (twice the particle's radius against a wall, `j ≥ n`).
+    fn scale(&self, radius: &[f64], n: usize, tol: f64) -> f64 {
+        let (i, j) = self.ij();
+        tol * if j < n {
+            radius[i] + radius[j]
+        } else {
+            2.0 * radius[i]
+        }
+    }
 }
 
 impl Sim<'_, '_> {
@@ -252,11 +263,7 @@ impl Sim<'_, '_> {
         let mut scale = std::mem::take(&mut self.eng.fast.scale);
         scale.clear();
         let r = &self.eng.radius;
-        scale.extend(contacts.iter().map(|c| {
-            let (i, j) = c.ij();
-            let s = if j < n { r[i] + r[j] } else { 2.0 * r[i] };
-            tol * s
-        }));
+        scale.extend(contacts.iter().map(|c| c.scale(r, n, tol)));
         let max = self.cfg.resting_sweeps as usize;
         let out = resting_fast::sweeps(contacts, &mut bodies, &scale, n, mu, max);
         for (i, b) in bodies.iter().enumerate() {
@@ -293,10 +300,11 @@ impl Sim<'_, '_> {
         let mut scale = std::mem::take(&mut self.eng.fast.scale);
         scale.clear();
         let r = &self.eng.radius;
-        scale.extend(lay.src.iter().map(|&k| {
-            let (i, j) = contacts[k as usize].ij();
-            tol * if j < n { r[i] + r[j] } else { 2.0 * r[i] }
-        }));
+        scale.extend(
+            lay.src
+                .iter()
+                .map(|&k| contacts[k as usize].scale(r, n, tol)),
+        );
         let max = self.cfg.nncg_sweeps as usize;
         let (grouped, aux) = (&mut lay.grouped, &mut lay.aux);
         let out = blocked::sweeps(grouped, &mut bodies, blocks, &scale, aux, mu, max);
@@ -333,15 +341,10 @@ impl Sim<'_, '_> {
             let m = contacts.len();
             for k in 0..m {
                 let c = &mut contacts[if backward { m - 1 - k } else { k }];
-                let (i, j) = c.ij();
-                let s = if j < n {
-                    self.eng.radius[i] + self.eng.radius[j]
-                } else {
-                    2.0 * self.eng.radius[i]
-                };
+                let scale = c.scale(&self.eng.radius, n, tol);
                 let dv = self.relax(c, mu);
                 worst = worst.max(dv);
-                worst_ratio = worst_ratio.max(dv / (tol * s));
+                worst_ratio = worst_ratio.max(dv / scale);
             }
             residual = worst;
             if worst_ratio < 1.0 || worst_ratio.is_nan() {
