@@ -254,12 +254,7 @@ impl Sim<'_, '_> {
         let n = self.n();
         let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
         bodies.clear();
-        bodies.extend((0..n).map(|i| Body {
-            v: self.p.velocities[i],
-            w: self.p.angular_velocities[i],
-            inv_mass: self.p.inv_masses[i],
-            inv_inertia: inv_inertia[i],
-        }));
+        bodies.extend((0..n).map(|i| self.fast_body(i, inv_inertia)));
         let mut scale = std::mem::take(&mut self.eng.fast.scale);
         scale.clear();
         let r = &self.eng.radius;
@@ -267,12 +262,27 @@ impl Sim<'_, '_> {
         let max = self.cfg.resting_sweeps as usize;
         let out = resting_fast::sweeps(contacts, &mut bodies, &scale, n, mu, max);
         for (i, b) in bodies.iter().enumerate() {
-            self.p.velocities[i] = b.v;
-            self.p.angular_velocities[i] = b.w;
+            self.store_fast_body(i, b);
         }
         self.eng.fast.bodies = bodies;
         self.eng.fast.scale = scale;
         out
+    }
+
+    /// Particle `i` as the fast sweeps see it (isotropic inverse inertia `inv_inertia[i]`).
+    fn fast_body(&self, i: usize, inv_inertia: &[f64]) -> Body {
+        Body {
+            v: self.p.velocities[i],
+            w: self.p.angular_velocities[i],
+            inv_mass: self.p.inv_masses[i],
+            inv_inertia: inv_inertia[i],
+        }
+    }
+
+    /// Write a fast sweep's velocities back to particle `i`.
+    fn store_fast_body(&mut self, i: usize, b: &Body) {
+        self.p.velocities[i] = b.v;
+        self.p.angular_velocities[i] = b.w;
     }
 
     /// The NNCG solve on blocks of the contact graph ([`blocked`]) for isotropic inertias.
@@ -288,15 +298,11 @@ impl Sim<'_, '_> {
         let blocks = blocked::layout(contacts, self.p.positions, self.domain, &mut lay);
         let mut bodies = std::mem::take(&mut self.eng.fast.bodies);
         bodies.clear();
-        bodies.extend(lay.perm.iter().map(|&i| {
-            let i = i as usize;
-            Body {
-                v: self.p.velocities[i],
-                w: self.p.angular_velocities[i],
-                inv_mass: self.p.inv_masses[i],
-                inv_inertia: inv_inertia[i],
-            }
-        }));
+        bodies.extend(
+            lay.perm
+                .iter()
+                .map(|&i| self.fast_body(i as usize, inv_inertia)),
+        );
         let mut scale = std::mem::take(&mut self.eng.fast.scale);
         scale.clear();
         let r = &self.eng.radius;
@@ -313,8 +319,7 @@ impl Sim<'_, '_> {
             (c.lambda_n, c.lambda_t) = (g.lambda_n, g.lambda_t);
         }
         for (b, &i) in bodies.iter().zip(&lay.perm) {
-            self.p.velocities[i as usize] = b.v;
-            self.p.angular_velocities[i as usize] = b.w;
+            self.store_fast_body(i as usize, b);
         }
         self.eng.fast.bodies = bodies;
         self.eng.fast.scale = scale;
