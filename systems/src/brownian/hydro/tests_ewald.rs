@@ -403,15 +403,7 @@ fn step_timing() {
         (MobilityMethod::Cholesky, 1000),
     ];
     for &(method, n) in cases {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-        let (pos, radii) = dilute_suspension(&mut rng, n, a);
-        let w = normals(&mut rng, n);
-        let f: Vec<DVec3> = normals(&mut rng, n).iter().map(|v| *v * 1e-14).collect();
-        let opts = MobilityOptions {
-            krylov_tolerance: 1e-3,
-            ewald_tolerance: 1e-4,
-            ..MobilityOptions::default()
-        };
+        let (pos, radii, w, f, opts) = step_inputs(n, a);
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -501,6 +493,30 @@ fn ewald_product_profile() {
     eprintln!("{:?} {}", op.summary(), v[0]);
 }
 
+/// The timing and profile probes' BD step inputs (seed 7): a 1 % suspension of `n` spheres
+/// of radius `a` [m], unit normal noise, forces of 1e-14 N scale and the tolerances.
+fn step_inputs(n: usize, a: f64) -> StepInputs {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
+    let w = normals(&mut rng, n);
+    let f: Vec<DVec3> = normals(&mut rng, n).iter().map(|v| *v * 1e-14).collect();
+    let opts = MobilityOptions {
+        krylov_tolerance: 1e-3,
+        ewald_tolerance: 1e-4,
+        ..MobilityOptions::default()
+    };
+    (pos, radii, w, f, opts)
+}
+
+/// Positions, radii, noise, forces and options of [`step_inputs`].
+type StepInputs = (
+    Vec<DVec3>,
+    Vec<f64>,
+    Vec<DVec3>,
+    Vec<DVec3>,
+    MobilityOptions,
+);
+
 /// One BD step of the N = 10⁴ benchmark (prepare with the kernel cached, noise, drift).
 fn one_step(pos: &[DVec3], radii: &[f64], w: &[DVec3], f: &[DVec3], opts: MobilityOptions) {
     let mob = Mobility::new_with(MobilityMethod::SpectralEwald, pos, radii, ETA, opts).unwrap();
@@ -519,15 +535,7 @@ fn one_step(pos: &[DVec3], radii: &[f64], w: &[DVec3], f: &[DVec3], opts: Mobili
 fn ewald_step_profile() {
     // the instruction count minus that of `ewald_prepare_profile` (the same set-up) is one step
     let (n, a) = (10_000, 75e-9);
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-    let (pos, radii) = dilute_suspension(&mut rng, n, a);
-    let w = normals(&mut rng, n);
-    let f: Vec<DVec3> = normals(&mut rng, n).iter().map(|v| *v * 1e-14).collect();
-    let opts = MobilityOptions {
-        krylov_tolerance: 1e-3,
-        ewald_tolerance: 1e-4,
-        ..MobilityOptions::default()
-    };
+    let (pos, radii, w, f, opts) = step_inputs(n, a);
     // warms the kernel cache (a simulation computes it once)
     let _ = SpectralEwald::new(&pos, &radii, ETA, opts.ewald_tolerance).unwrap();
     one_step(&pos, &radii, &w, &f, opts);
