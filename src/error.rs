@@ -30,8 +30,9 @@ impl SceneError {
     }
 }
 
-/// `text` with every decimal number of more than 20 digits (or 12 with a decimal point) in
-/// scientific notation; 64-bit integers stay exact.
+/// `text` with long numbers in scientific notation: more than 20 digits, more than 12 with a
+/// decimal point, decimals below 1e-4 (`0.000000075` -> `7.5e-8`), and round integers from
+/// 1e7 (`20000000` -> `2e7`); other integers (counts) stay exact.
 pub fn compact_numbers(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let b = text.as_bytes();
@@ -62,7 +63,12 @@ pub fn compact_numbers(text: &str) -> String {
         let number = &text[i..j];
         let followed_by_word = j < b.len() && is_word(b[j]);
         match number.parse::<f64>() {
-            Ok(v) if (digits > 20 || (dot && digits > 12)) && !followed_by_word => {
+            Ok(v)
+                if !followed_by_word
+                    && (digits > 20
+                        || (dot && (digits > 12 || (v != 0.0 && v < 1e-4)))
+                        || (!dot && digits >= 8 && number.ends_with("000000"))) =>
+            {
                 out.push_str(&format!("{v:e}"))
             }
             _ => out.push_str(number),
@@ -128,6 +134,10 @@ mod tests {
             "in (0, 0.3], got 12.5"
         );
         assert_eq!(compact_numbers("particles[12].x"), "particles[12].x");
+        assert_eq!(compact_numbers("got -0.000000001"), "got -1e-9");
+        assert_eq!(compact_numbers("radius 0.000000075 m"), "radius 7.5e-8 m");
+        assert_eq!(compact_numbers("got 0.0005, 20000000"), "got 0.0005, 2e7");
+        assert_eq!(compact_numbers("12345678 particles"), "12345678 particles");
         // digits inside a word (a hash, a name) are left alone
         assert_eq!(
             compact_numbers("id a12345678901234567"),
@@ -236,6 +246,12 @@ pub enum ReplayError {
         "the recording has no `magsep` metadata record (scene text, seed): not written by magsep run"
     )]
     NoMetadata,
+    /// The file ends before its `magsep` metadata record (a run killed at its start).
+    #[error(
+        "the recording ends before its `magsep` metadata record (scene text, seed), so there is \
+         nothing to replay: {0}"
+    )]
+    TruncatedBeforeMetadata(String),
     /// The recorded scene does not parse with this program.
     #[error("the recorded scene is invalid:\n{0}")]
     Scene(#[from] SceneErrors),

@@ -19,8 +19,8 @@ use magsep_systems::rng::rng_from_state_words;
 use serde_json::Value;
 
 pub use crate::error::ReplayError;
-use crate::scene::{Registry, RunOptions, Scene, parse_scene, spawn_scene};
-use crate::sim::{SimError, Simulation};
+use crate::scene::{Progress, Registry, RunOptions, Scene, parse_scene, spawn_scene};
+use crate::sim::{SimError, Simulation, run_scene};
 
 /// Spawn the particles of `frame` into `world` and set the container, clock and status.
 /// `shapes` (in id order, from the recorded scene) override the frame's radii and half
@@ -127,7 +127,7 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
 /// [`ReplayError`].
 pub fn replay_with(path: &Path, registry: &Registry) -> Result<(Value, Recording), ReplayError> {
     let rec = read_recording(path)?;
-    let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
+    let meta = metadata_of(&rec)?;
     let scene = parse_scene(&meta.scene_text, registry)?;
     let pipeline = scene.pipeline.clone().ok_or_else(|| {
         ReplayError::Unsupported("the recorded scene is field-only: nothing to replay".into())
@@ -264,22 +264,23 @@ pub fn resume(
     registry: &Registry,
     record: Option<PathBuf>,
     plugins: &[Arc<dyn SimPlugin>],
-    on_step: impl FnMut(&World),
+    progress: &dyn Progress,
 ) -> Result<Value, ReplayError> {
     let rec = read_recording(path)?;
-    let meta = rec.metadata.clone().ok_or(ReplayError::NoMetadata)?;
+    let meta = metadata_of(&rec)?;
     let mut scene = parse_scene(&meta.scene_text, registry)?;
     scene.overrides = recorded_overrides(&meta);
     let frame = last_frame(&rec)?.clone();
     check_resume(&scene, &meta, &rec, &frame)?;
     let options = RunOptions {
         seed: Some(meta.seed),
-        record,
         resume_from: Some(frame),
         plugins: plugins.to_vec(),
         ..Default::default()
     };
-    let mut sim = Simulation::from_scene(&scene, options).map_err(|e| match e {
+    // the frame fits the pipeline and the schedule has the recorded systems: checked on a
+    // simulation that records nothing, before the run
+    let sim = Simulation::from_scene(&scene, options.clone()).map_err(|e| match e {
         SimError::Resume(m) if m.contains("does not record enough state") => {
             ReplayError::Unsupported(m)
         }
@@ -289,7 +290,21 @@ pub fn resume(
     if !missing.is_empty() {
         return Err(ReplayError::MissingPlugins(missing.join(", ")));
     }
-    Ok(sim.run(on_step)?)
+    drop(sim);
+    // the pipeline's own way: a brownian ensemble resumes its recorded replicate 0 and runs
+    // the others (not recorded, reproducible from the seed) again, so that the summary is
+    // the whole run's
+    let options = RunOptions { record, ..options };
+    Ok(run_scene(&scene, &options, progress)?)
+}
+
+/// The recording's `magsep` metadata, or why it has none (cut before it, or not magsep's).
+fn metadata_of(rec: &Recording) -> Result<RecordingMetadata, ReplayError> {
+    match (&rec.metadata, &rec.truncated) {
+        (Some(m), _) => Ok(m.clone()),
+        (None, Some(t)) => Err(ReplayError::TruncatedBeforeMetadata(t.clone())),
+        (None, None) => Err(ReplayError::NoMetadata),
+    }
 }
 
 /// The overrides a recording's metadata lists (`extra["overrides"]`; empty when absent).

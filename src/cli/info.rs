@@ -42,7 +42,8 @@ struct Scan {
 }
 
 /// Reads the recording at `path` linearly, checking every CRC; frames are decoded and
-/// counted, not kept. Fails (bad input) when nothing at all can be read.
+/// counted, not kept. Fails (bad input) when the file cannot be opened as a recording at all
+/// (no MCAP magic, unreadable); damage further on is reported in the scan.
 fn scan(path: &Path) -> Result<Scan, CliError> {
     let mut reader = RecordingReader::open_with(path, ReadMode::Linear, ReaderLimits::default())
         .map_err(|e| record_error(path, e))?;
@@ -64,7 +65,8 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
     }
     let trailing = reader.trailing_bytes();
     let (truncated, damaged) = match failure {
-        Some(e) if frames == 0 => return Err(record_error(path, e)),
+        // damage before the first frame: the header, metadata and channels read before it
+        // are still printed (and the exit code says damaged)
         Some(e) => {
             let msg = format!("{e}; reading stopped there: {frames} complete frames read");
             (Some(msg.clone()), Some(msg))
@@ -159,10 +161,10 @@ pub fn info(path: &Path, as_json: bool, registry: &Registry) -> Result<(), CliEr
             "interrupted by {why}: the run was stopped before its end"
         ));
     }
-    line(format!(
-        "frames     {} (steps {:?}..{:?})",
-        rec.frames, rec.first_step, rec.last_step
-    ));
+    match (rec.first_step, rec.last_step) {
+        (Some(a), Some(b)) => line(format!("frames     {} (steps {a}..{b})", rec.frames)),
+        _ => line(format!("frames     {}", rec.frames)),
+    }
     line("channels".into());
     for c in &rec.channels {
         line(format!(
@@ -288,20 +290,10 @@ pub fn resume(
         }
         check_file("--record", out, &inputs, force)?;
     }
-    let bar = if quiet {
-        indicatif::ProgressBar::hidden()
-    } else {
-        indicatif::ProgressBar::new_spinner()
-    };
-    let summary = crate::replay::resume(path, &ext.registry, record, &ext.plugins, |w| {
-        if let Some(c) = w.get_resource::<crate::components::clock::StepClock>()
-            && c.step % 1000 == 0
-        {
-            bar.set_message(format!("step {}", c.step));
-            bar.tick();
-        }
-    })
-    .map_err(|e| replay_error(path, e))?;
-    bar.finish_and_clear();
+    let progress = super::progress::StderrProgress::new(quiet, "steps");
+    let summary = crate::replay::resume(path, &ext.registry, record, &ext.plugins, &progress)
+        .map_err(|e| replay_error(path, e));
+    drop(progress);
+    let summary = summary?;
     print(serde_json::to_string_pretty(&summary).unwrap_or_default())
 }

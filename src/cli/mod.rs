@@ -26,6 +26,7 @@ use clap::{Parser, Subcommand};
 mod field;
 mod info;
 mod output;
+pub mod progress;
 mod run;
 pub mod signals;
 mod sweep;
@@ -247,6 +248,7 @@ pub fn main() -> i32 {
 /// The CLI with `ext`'s pipelines and plugins; parses the process arguments, runs, prints
 /// errors, and returns the exit code.
 pub fn main_with(ext: Extensions) -> i32 {
+    signals::survive_file_size_limit();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -5,11 +5,12 @@ use std::path::{Path, PathBuf};
 use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::overrides::{Override, apply_overrides};
-use crate::scene::{ExecutorChoice, Progress, RunOptions, Scene, parse_scene};
+use crate::scene::{ExecutorChoice, RunOptions, Scene, parse_scene};
 use crate::sim::{SimError, StopFlag, run_scene};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressStyle;
 
 use super::output::{Input, check_file, print};
+use super::progress::StderrProgress;
 use super::{CliError, Extensions, signals};
 
 /// Most worker threads `--threads` accepts: more than any machine has cores, and cheap to
@@ -145,27 +146,6 @@ pub fn validate(
     }))
 }
 
-/// A progress bar on stderr (a spinner until the total is known).
-struct Bar(ProgressBar);
-
-impl Progress for Bar {
-    fn set_total(&self, steps: u64) {
-        self.0.set_length(steps);
-        self.0.set_style(
-            ProgressStyle::with_template(
-                "[{elapsed_precise}] {bar:40} {pos}/{len} steps ({eta} left) {msg}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-    }
-    fn advance(&self, steps: u64) {
-        self.0.inc(steps);
-    }
-    fn message(&self, text: String) {
-        self.0.set_message(text);
-    }
-}
-
 /// `magsep run --executor`: how the step's systems are scheduled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Executor {
@@ -235,17 +215,13 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         stop: Some(stop),
         ..Default::default()
     };
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new_spinner()
-    };
-    bar.set_style(
+    let progress = StderrProgress::new(quiet, "steps");
+    progress.bar().set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_spinner()),
     );
-    let result = run_scene(&scene, &options, &Bar(bar.clone()));
-    bar.finish_and_clear();
+    let result = run_scene(&scene, &options, &progress);
+    drop(progress);
     if let Some(partial) = result.as_ref().err().and_then(SimError::partial_summary) {
         // the run's error matters more than a failing stdout
         let _ = print(serde_json::to_string_pretty(partial).unwrap_or_default());

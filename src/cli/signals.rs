@@ -8,6 +8,11 @@
 //! number: [`EXIT_SIGINT`] (130) or [`EXIT_SIGTERM`] (143), the shell's convention. A second
 //! signal exits at once, with its own code, leaving the recording as a truncated file whose
 //! finished frames stay readable.
+//!
+//! SIGXFSZ (a write past the process's file-size limit, `ulimit -f`) would kill the process by
+//! default, with no summary and no word on why; [`survive_file_size_limit`] replaces that
+//! action, so the write fails with EFBIG ("File too large") and the run ends as for any write
+//! failure: its summary with `run_error`, exit code 1.
 
 use crate::sim::StopFlag;
 
@@ -16,7 +21,7 @@ pub const EXIT_SIGINT: i32 = 130;
 /// Exit code of a run stopped by SIGTERM (128 + 15).
 pub const EXIT_SIGTERM: i32 = 143;
 
-pub use imp::{SignalGuard, install};
+pub use imp::{SignalGuard, install, survive_file_size_limit};
 
 #[cfg(unix)]
 mod imp {
@@ -83,6 +88,14 @@ mod imp {
         })
     }
 
+    /// Let writes past the file-size limit fail (EFBIG) instead of killing the process with
+    /// SIGXFSZ (see the module docs). Best effort: if the action cannot be set, the OS default
+    /// stays.
+    pub fn survive_file_size_limit() {
+        let seen = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, seen);
+    }
+
     impl SignalGuard {
         /// The exit code of the first signal received (130, 143), if one was.
         pub fn exit_code(&self) -> Option<i32> {
@@ -117,6 +130,9 @@ mod imp {
     pub fn install(_stop: &StopFlag) -> std::io::Result<SignalGuard> {
         Ok(SignalGuard)
     }
+
+    /// Nothing to change on this platform.
+    pub fn survive_file_size_limit() {}
 
     impl SignalGuard {
         /// Always `None`.

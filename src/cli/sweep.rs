@@ -4,9 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressStyle;
 
 use super::output::{check_dir, print};
+use super::progress::StderrProgress;
 use super::{CliError, Extensions};
 use crate::studies::sweep::{self, SweepError, slurm::SlurmOptions};
 
@@ -170,11 +171,8 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 Some(j) => j.min(super::run::MAX_THREADS),
                 None => std::thread::available_parallelism().map_or(1, |n| n.get()),
             };
-            let bar = if cmd.quiet {
-                ProgressBar::hidden()
-            } else {
-                ProgressBar::new(0)
-            };
+            let progress = StderrProgress::new(cmd.quiet, "points");
+            let bar = progress.bar();
             bar.set_style(
                 ProgressStyle::with_template(
                     "[{elapsed_precise}] {bar:40} {pos}/{len} points ({eta} left)",
@@ -191,8 +189,9 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 memory_budget: crate::scene::memory::budget(cmd.memory_budget)
                     .map_err(CliError::input)?,
             };
-            let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), &bar)
-                .map_err(to_cli)?;
+            let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), bar);
+            drop(progress);
+            let result = result.map_err(to_cli)?;
             print(pretty(&result))?;
             let failed = result["failed"]
                 .as_u64()

@@ -256,7 +256,7 @@ pub fn check(errors: &mut Vec<SceneError>, ok: bool, path: &str, message: impl F
 /// An error at `path` unless `v` is finite and > 0.
 pub fn finite_positive(errors: &mut Vec<SceneError>, path: &str, v: f64) {
     check(errors, v.is_finite() && v > 0.0, path, || {
-        format!("must be a finite number > 0, got {v}")
+        format!("must be a finite number > 0, got {}", num(v))
     });
 }
 
@@ -266,7 +266,7 @@ pub fn in_range(errors: &mut Vec<SceneError>, path: &str, v: f64, lo_open: f64, 
         errors,
         v.is_finite() && v > lo_open && v <= hi,
         path,
-        || format!("must be in ({lo_open}, {hi}], got {v}"),
+        || format!("must be in ({}, {}], got {}", num(lo_open), num(hi), num(v)),
     );
 }
 
@@ -280,7 +280,12 @@ pub fn exponent_in_range(errors: &mut Vec<SceneError>, path: &str, g: f64) {
         errors,
         g.is_finite() && (2.0..=MAX_EXPONENT).contains(&g),
         path,
-        || format!("must be in [2, {MAX_EXPONENT}] (strictly convex shapes), got {g}"),
+        || {
+            format!(
+                "must be in [2, {MAX_EXPONENT}] (strictly convex shapes), got {}",
+                num(g)
+            )
+        },
     );
 }
 
@@ -288,7 +293,17 @@ pub fn exponent_in_range(errors: &mut Vec<SceneError>, path: &str, g: f64) {
 /// `"[m]"`, is named in the message).
 pub fn within(errors: &mut Vec<SceneError>, path: &str, v: f64, lo: f64, hi: f64, unit: &str) {
     check(errors, v.is_finite() && v >= lo && v <= hi, path, || {
-        format!("must be in [{}, {}] {unit}, got {v}", num(lo), num(hi))
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        format!(
+            "must be in [{}, {}]{unit}, got {}",
+            num(lo),
+            num(hi),
+            num(v)
+        )
     });
 }
 

@@ -297,3 +297,20 @@ magnetisation = [0.0, 0.0, 1e5]
     let ext = world.resource::<magsep_components::fibre::ExternalField>();
     assert_eq!(ext.flux_density, glam::DVec3::Z);
 }
+
+#[test]
+fn an_error_in_simulation_does_not_disown_the_pipelines_sections() {
+    for bad in ["bogus = 1\n", "seed = -1\n"] {
+        let text = GOOD.replace("seed = 1\n", bad);
+        let e = errors(&text);
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(e[0].path.starts_with("simulation"), "{e:?}");
+    }
+    // the packing sections are still checked: a real error beside it is reported too
+    let text = GOOD
+        .replace("seed = 1\n", "bogus = 1\n")
+        .replace("step_halvings = 4", "step_halvings = 99");
+    let e = errors(&text);
+    assert!(has(&e, "packing.step_halvings"), "{e:?}");
+    assert!(!has(&e, "container"), "{e:?}");
+}

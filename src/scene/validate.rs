@@ -293,6 +293,13 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
         }
         p
     });
+    // a [simulation] with another error still names its pipeline: the other sections are
+    // checked as that pipeline's (no false "only for pipeline = ..." beside the real error)
+    let pipeline = pipeline.or_else(|| {
+        simulation.is_none().then_some(())?;
+        let name = table.get("simulation")?.get("pipeline")?.as_str()?;
+        registry.pipeline(name).cloned()
+    });
     let current = pipeline.as_ref().map(|p| p.name());
     let mut particles = Vec::new();
     let mut record = None;

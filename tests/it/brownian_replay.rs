@@ -4,6 +4,7 @@
 use magsep::plugins::record::read_recording;
 use magsep::prelude::*;
 use magsep::replay::resume;
+use magsep::scene::NoProgress;
 use magsep::scene::parse_scene;
 
 const SCENE: &str = r#"
@@ -95,7 +96,7 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
         &Default::default(),
         Some(resumed_path.clone()),
         &[],
-        |_| {},
+        &NoProgress,
     )
     .unwrap();
     for key in [
@@ -123,5 +124,43 @@ fn replay_reproduces_the_capture_curve_and_resume_is_bitwise() {
         "resumed run differs from the uninterrupted one"
     );
     assert_eq!(a.status_json, b.status_json);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn resume_of_an_ensemble_gives_the_whole_runs_summary_and_replay_says_it_has_one_replicate() {
+    let dir = std::env::temp_dir().join(format!("magsep-bd-ensemble-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let full = dir.join("full.mcap");
+    let text = SCENE.replace("observe_every = 20", "observe_every = 20\nruns = 3");
+    let scene = parse_scene(&text, &Default::default()).unwrap();
+    let options = RunOptions {
+        record: Some(full.clone()),
+        ..Default::default()
+    };
+    let summary = magsep::sim::run_scene(&scene, &options, &NoProgress).unwrap();
+    assert_eq!(summary["runs"], 3);
+
+    // replay has replicate 0 only, and says so
+    let (replayed, _) = magsep::replay::replay(&full).unwrap();
+    assert_eq!(replayed["runs"], 1);
+    assert_eq!(replayed["runs_in_scene"], 3);
+    assert!(replayed["note"].as_str().unwrap().contains("replicate 0"));
+
+    // resume from a cut file: replicate 0 continues, the others run again: the whole run
+    let bytes = std::fs::read(&full).unwrap();
+    let cut = dir.join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    assert!(read_recording(&cut).unwrap().frames.len() >= 2);
+    let resumed = resume(&cut, &Default::default(), None, &[], &NoProgress).unwrap();
+    for key in [
+        "runs",
+        "capture_curve",
+        "captured_fraction",
+        "brownian_fraction",
+        "steps",
+    ] {
+        assert_eq!(resumed[key], summary[key], "{key}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

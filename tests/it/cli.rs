@@ -231,3 +231,28 @@ fn every_executor_records_the_same_frames() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--executor"), "{}", stderr(&o));
 }
+
+#[test]
+fn progress_goes_to_a_log_as_plain_lines_and_quiet_silences_it() {
+    // stderr is a pipe here, not a terminal: the bar becomes a line every interval
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/spheres_500.toml");
+    let run = |quiet: bool| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_magsep"));
+        cmd.args(["run", scene])
+            .env(magsep::cli::progress::INTERVAL_ENV, "0.05");
+        if quiet {
+            cmd.arg("--quiet");
+        }
+        cmd.output().expect("binary runs")
+    };
+    let o = run(false);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains(" steps")).collect();
+    assert!(!lines.is_empty(), "no progress line in: {err}");
+    assert!(lines.iter().all(|l| l.starts_with('[')), "{err}");
+    assert!(json(&o)["packing_fraction"].as_f64().unwrap() > 0.6);
+    let o = run(true);
+    assert!(o.status.success());
+    assert!(!stderr(&o).contains(" steps"), "{}", stderr(&o));
+}

@@ -167,7 +167,9 @@ fn replay_recomputes_the_separation_curve_of_the_run() {
     let dir = std::env::temp_dir().join(format!("magsep-pf-replay-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("lev.mcap");
-    let text = levitation_scene(1.0, "").replace("every = 100", "every = 10");
+    // without history the sphere settles at ~2.15 s: the replay sees the levitation
+    let text =
+        levitation_scene(3.0, "terms = { history = false }").replace("every = 100", "every = 10");
     let (_, summary) = run(
         &text,
         RunOptions {
@@ -187,6 +189,26 @@ fn replay_recomputes_the_separation_curve_of_the_run() {
     for (x, y) in ea.iter().zip(eb) {
         assert!((x.as_f64().unwrap() - y.as_f64().unwrap()).abs() < 1e-14);
     }
+    // levitation times at frame resolution: the last frame outside the band is at most one
+    // frame interval before the run's last step outside
+    let res = replayed["levitation_time_resolution_s"].as_f64().unwrap();
+    assert!((res - 10.0 * 1e-3).abs() < 1e-9, "{res}");
+    let (ta, tb) = (
+        summary["particle_details"][0]["levitation_time"].as_f64(),
+        replayed["particle_details"][0]["levitation_time"].as_f64(),
+    );
+    let (ta, tb) = (
+        ta.expect("the run settles"),
+        tb.expect("the replay sees it"),
+    );
+    assert!(tb <= ta && ta - tb <= res + 1e-12, "run {ta}, replay {tb}");
+    assert_eq!(replayed["settled_particles"], summary["settled_particles"]);
+    // what frames cannot give is null and listed, never a made-up zero
+    for key in ["max_reynolds", "collisions", "liquid_solver"] {
+        assert!(replayed[key].is_null(), "{key}: {}", replayed[key]);
+    }
+    assert!(replayed["particle_details"][0]["velocity"].is_null());
+    assert_eq!(replayed["not_recomputed"].as_array().unwrap().len(), 4);
     std::fs::remove_dir_all(&dir).ok();
 }
 

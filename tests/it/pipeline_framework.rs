@@ -7,6 +7,7 @@ use bevy_ecs::prelude::*;
 use magsep::plugins::record::read_recording;
 use magsep::prelude::*;
 use magsep::replay::resume;
+use magsep::scene::NoProgress;
 use magsep::scene::parse_scene;
 use magsep_systems::sets::SimSystems;
 
@@ -150,13 +151,13 @@ fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
         .collect();
     assert!(plugins.contains(&"CountPlugin".to_string()), "{plugins:?}");
     // without the plugin: refused, naming the missing system
-    let err = resume(&path, &Default::default(), None, &[], |_| {}).unwrap_err();
+    let err = resume(&path, &Default::default(), None, &[], &NoProgress).unwrap_err();
     assert!(
         matches!(err, magsep::error::ReplayError::MissingPlugins(ref m) if m.contains("count_steps")),
         "{err}"
     );
     // with it: the run continues to its end
     let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(CountPlugin);
-    let summary = resume(&path, &Default::default(), None, &[plugin], |_| {}).unwrap();
+    let summary = resume(&path, &Default::default(), None, &[plugin], &NoProgress).unwrap();
     assert_eq!(summary["steps"], 100);
 }

@@ -79,7 +79,12 @@ pub fn run_ensemble(
             pipeline: options.pipeline.clone(),
             single_threaded: options.single_threaded || runs > 1,
             executor: options.executor,
-            resume_from: None,
+            // only replicate 0 is recorded: the others start afresh from their seeds
+            resume_from: if k == 0 {
+                options.resume_from.clone()
+            } else {
+                None
+            },
             plugins: options.plugins.clone(),
             stop: Some(stop.clone()),
         };

@@ -180,7 +180,8 @@ pub fn start_regions(scene: &Scene) -> StartRegions {
     )
 }
 
-/// Summary of a brownian recording recomputed from its last frame.
+/// Summary of a brownian recording recomputed from its last frame (of replicate 0, the one
+/// recorded: with `runs > 1` the summary says so in `runs_in_scene` and `note`).
 ///
 /// # Errors
 /// [`ReplayError`] when the recording has no frame or its state is malformed.
@@ -194,6 +195,18 @@ pub fn replay_brownian(rec: &Recording, scene: &Scene, seed: u64) -> Result<Valu
     let wall = recorded_wall_time(rec);
     let mut summary = summary_of(&[result], &start_regions(scene), &config, wall);
     summary["frames"] = rec.frames.len().into();
+    let runs = scene
+        .section::<super::BrownianSection>()
+        .map_or(1, |s| s.runs());
+    if runs > 1 {
+        // only replicate 0 is recorded: say so rather than pass one replicate off as the run
+        summary["runs_in_scene"] = runs.into();
+        summary["note"] = format!(
+            "the recording holds replicate 0 of the scene's {runs} runs: this summary is that \
+             replicate's; `replay --resume` runs the others again for the whole ensemble"
+        )
+        .into();
+    }
     if let Some(t) = &rec.truncated {
         summary["truncated"] = Value::String(t.clone());
     }

@@ -148,7 +148,7 @@ fn positive(errors: &mut Vec<SceneError>, path: &str, v: f64, unit: &str) {
     if !(v.is_finite() && v > 0.0) {
         errors.push(SceneError::new(
             path,
-            format!("must be a finite number > 0{unit}, got {v}"),
+            format!("must be a finite number > 0{unit}, got {}", num(v)),
         ));
     }
 }
@@ -159,7 +159,7 @@ pub fn validate_section(b: &BrownianSection, errors: &mut Vec<SceneError>) {
     if b.time_step > 1.0 {
         errors.push(SceneError::new(
             "brownian.time_step",
-            format!("must be <= 1 s, got {}", b.time_step),
+            format!("must be <= 1 s, got {}", num(b.time_step)),
         ));
     }
     positive(errors, "brownian.duration", b.duration, " [s]");
@@ -364,7 +364,11 @@ pub fn validate_group(
             if !(gap.is_finite() && *gap > radius) {
                 errors.push(SceneError::new(
                     format!("{q}.gap"),
-                    format!("must exceed the particle radius {radius} m, got {gap}"),
+                    format!(
+                        "must exceed the particle radius {} m, got {}",
+                        num(radius),
+                        num(*gap)
+                    ),
                 ));
             }
         }
@@ -379,7 +383,11 @@ pub fn validate_group(
             if !(gap.is_finite() && *gap > radius) {
                 errors.push(SceneError::new(
                     format!("{q}.gap"),
-                    format!("must exceed the particle radius {radius} m, got {gap}"),
+                    format!(
+                        "must exceed the particle radius {} m, got {}",
+                        num(radius),
+                        num(*gap)
+                    ),
                 ));
             }
         }

@@ -93,14 +93,19 @@ pub fn validate(
         errors,
         s.time_step.is_finite() && s.time_step > 0.0 && s.time_step <= 1.0,
         "particle_fluid.time_step",
-        || format!("must be in (0, 1] s, got {}", s.time_step),
+        || format!("must be in (0, 1] s, got {}", num(s.time_step)),
     );
     let steps = s.duration / s.time_step;
     check(
         errors,
         s.duration.is_finite() && (0.5..=1e9).contains(&steps),
         "particle_fluid.duration",
-        || format!("must give 1 to 1e9 steps of time_step, got {}", s.duration),
+        || {
+            format!(
+                "must give 1 to 1e9 steps of time_step, got {}",
+                num(s.duration)
+            )
+        },
     );
     if let Some(g) = s.gravity {
         check(
@@ -249,10 +254,23 @@ fn validate_group(
             polar_radius: c,
         } => {
             let w = c / a;
+            // at the key that gave w when the scene gives it directly, else at the shape
+            let given = matches!(
+                g.shape,
+                crate::scene::ShapeSpec::Spheroid {
+                    aspect_ratio: Some(_),
+                    ..
+                }
+            );
+            let at = if given {
+                format!("{p}.shape.aspect_ratio")
+            } else {
+                format!("{p}.shape")
+            };
             check(
                 errors,
                 w.is_nan() || (MIN_ASPECT_RATIO..=1.0 + 1e-12).contains(&w),
-                &format!("{p}.shape"),
+                &at,
                 || {
                     format!(
                         "the particle_fluid pipeline simulates oblate spheroids with aspect \

@@ -58,6 +58,7 @@ fn resume_continues_bit_for_bit() {
     }
     let partial = sim.summary();
     sim.finish_recording(&partial).unwrap();
-    let resumed = resume(&path, &registry(), None, &[], |_| {}).expect("resume");
+    let resumed =
+        resume(&path, &registry(), None, &[], &magsep::scene::NoProgress).expect("resume");
     assert_eq!(without_wall_time(resumed), without_wall_time(whole));
 }
