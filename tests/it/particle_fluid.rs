@@ -106,6 +106,10 @@ fn the_summary_states_terms_closed_forms_and_stability() {
         !terms.contains("undisturbed_flow") && terms.contains("collisions"),
         "{terms}"
     );
+    // spheres only: no spheroid term is listed (none is registered)
+    for t in ["lift", "pitching_torque", "magnetic_torque"] {
+        assert!(!terms.contains(t), "{terms}");
+    }
     // the explicit scheme at the thesis's step is flagged for small particles only
     let small = shipped("levitation_single.toml")
         .replace("radius = 2.5e-3", "radius = 0.15e-3")

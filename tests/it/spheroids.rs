@@ -72,6 +72,12 @@ fn v2_levitation_time_grows_as_the_flake_gets_flatter() {
 #[test]
 fn v10_the_one_to_ten_disc_levitates_at_its_equilibrium_height() {
     let (mut sim, summary) = run(&shipped("flake_disc.toml"));
+    // a flake: the spheroid terms act and are listed
+    let terms = summary["terms_used"].to_string();
+    assert!(
+        terms.contains("lift") && terms.contains("pitching_torque"),
+        "{terms}"
+    );
     let z = details(&summary)[0]["position"][2].as_f64().unwrap();
     assert!((0.0487..=0.0492).contains(&z), "equilibrium {z}");
     // largest Reynolds number on the experiment's 5 mm disc diameter: thesis 7.6 (the

@@ -6,6 +6,7 @@ use magsep_components::prelude::*;
 use magsep_systems::fluid::channel::systems::ChannelLiquid;
 use magsep_systems::fluid::config::{HistoryChoice, Integrator, ParticleFluidConfig};
 use magsep_systems::fluid::observe::{SeparationCurve, separation_scale};
+use magsep_systems::fluid::spheroid_systems::SpheroidFluid;
 use serde_json::{Value, json};
 
 /// Per-particle details are listed for runs of at most this many particles.
@@ -158,7 +159,7 @@ pub fn run_summary(world: &World, seed: u64, wall_time_s: f64) -> Value {
         "steps": steps,
         "time_step": cfg.dt,
         "simulated_time": t_end,
-        "terms_used": cfg.active_terms(),
+        "terms_used": terms_used(world, cfg),
         "integrator": cfg.integrator,
         "drag_law": cfg.drag_law,
         "history": if cfg.terms.history { history } else { Value::Null },
@@ -209,3 +210,16 @@ fn liquid_json(world: &World, cfg: &ParticleFluidConfig) -> Value {
 fn finite(x: f64) -> Value {
     if x.is_finite() { json!(x) } else { Value::Null }
 }
+
+/// The terms switched on that can act on the scene's particles: lift, pitching torque and
+/// magnetic torque act on spheroids only (the pipeline registers them only then).
+fn terms_used(world: &World, cfg: &ParticleFluidConfig) -> Vec<&'static str> {
+    let spheroids = world.iter_entities().any(|e| e.contains::<SpheroidFluid>());
+    cfg.active_terms()
+        .into_iter()
+        .filter(|t| spheroids || !SPHEROID_ONLY_TERMS.contains(t))
+        .collect()
+}
+
+/// Terms that act on spheroids only.
+const SPHEROID_ONLY_TERMS: [&str; 3] = ["lift", "pitching_torque", "magnetic_torque"];
