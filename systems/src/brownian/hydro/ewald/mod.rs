@@ -137,6 +137,22 @@ impl SpectralEwald {
         Ok(Self::with_params(params, positions, radii, viscosity))
     }
 
+    /// As [`SpectralEwald::with_cutoff`] with the Gaussian support widened by `extra` points
+    /// (the probe of the error against the support).
+    #[cfg(test)]
+    pub fn with_cutoff_support(
+        positions: &[DVec3],
+        radii: &[f64],
+        viscosity: f64,
+        tolerance: f64,
+        cutoff: Option<f64>,
+        extra: usize,
+    ) -> Result<Self, HydroError> {
+        check_tolerance(tolerance)?;
+        let params = Params::with_cutoff_support(tolerance, cutoff, positions, radii, extra);
+        Ok(Self::with_params(params, positions, radii, viscosity))
+    }
+
     fn with_params(params: Params, positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
         let real = if params.is_direct() {
             Real::Direct(Direct::new(positions, radii, viscosity))
