@@ -347,3 +347,50 @@ fn support_error_probe() {
         );
     }
 }
+
+#[test]
+#[ignore = "probe: cargo test --release -p magsep-systems --lib prepare_parts_timing -- --ignored --nocapture"]
+fn prepare_parts_timing() {
+    // the parts of one N = 10⁴ preparation (kernel cached), medians of 5, 1 and 2 threads
+    use super::ewald::near::Near;
+    use super::ewald::params::Params;
+    use super::ewald::wave::Wave;
+    use std::time::Instant;
+    let (n, a) = (10_000, 75e-9);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
+    let _ = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut t = vec![Vec::new(); 5];
+            for _ in 0..5 {
+                let c = Instant::now();
+                let p = Params::choose(1e-4, &pos, &radii, 12.0).unwrap();
+                t[0].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let near = Near::new(&p, &pos, &radii, ETA);
+                t[1].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let wave = Wave::new(&p, &pos, &radii, 1.0);
+                t[2].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let pc = precond::ClusterFactor::new(&pos, &radii, ETA);
+                t[3].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                drop((near, wave, pc));
+                t[4].push(c.elapsed().as_secs_f64());
+            }
+            for v in &mut t {
+                v.sort_by(f64::total_cmp);
+            }
+            eprintln!(
+                "threads {threads}: params {:.4} s, near {:.4} s, wave {:.4} s, cluster factor {:.4} s, drop {:.4} s",
+                t[0][2], t[1][2], t[2][2], t[3][2], t[4][2]
+            );
+        });
+    }
+}

@@ -76,6 +76,7 @@ pub(crate) mod fft3;
 pub(crate) mod kernels;
 pub(crate) mod near;
 pub mod params;
+pub(crate) mod simd;
 pub(crate) mod wave;
 
 use glam::DVec3;
