@@ -224,8 +224,9 @@ pub struct EwaldSummary {
     pub grid: usize,
     /// Gaussian support P (points per side)
     pub support: usize,
-    /// stored real-space pair blocks (each pair twice; for the direct sum only the
-    /// overlapping pairs, the others are evaluated on the fly)
+    /// real-space pair blocks of the operator (each pair counted twice, once per row, and
+    /// stored once; for the direct sum only the overlapping pairs, the others are evaluated
+    /// on the fly)
     pub pair_blocks: usize,
 }
 
