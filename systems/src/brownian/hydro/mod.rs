@@ -251,15 +251,24 @@ impl Mobility {
             MobilityMethod::Krylov => Inner::Krylov {
                 m: DenseSym::rpy(positions, radii, viscosity),
             },
-            MobilityMethod::SpectralEwald => Inner::SpectralEwald {
-                op: Box::new(ewald::SpectralEwald::new(
-                    positions,
-                    radii,
-                    viscosity,
-                    options.ewald_tolerance,
-                )?),
-                pc: precond::ClusterFactor::new(positions, radii, viscosity),
-            },
+            MobilityMethod::SpectralEwald => {
+                // the (sequential) cluster factor is built beside the operator
+                let (op, pc) = rayon::join(
+                    || {
+                        ewald::SpectralEwald::new(
+                            positions,
+                            radii,
+                            viscosity,
+                            options.ewald_tolerance,
+                        )
+                    },
+                    || precond::ClusterFactor::new(positions, radii, viscosity),
+                );
+                Inner::SpectralEwald {
+                    op: Box::new(op?),
+                    pc,
+                }
+            }
         };
         Ok(Self {
             method,

@@ -77,6 +77,15 @@ fn fast_spreading_and_gathering_match_the_reference_loops() {
         eprintln!("polydisperse {poly}: fast vs reference {e:e}");
         assert!(e < 1e-13, "polydisperse {poly}: {e}");
         assert!(reference.iter().any(|v| *v != 0.0));
+        // every vector level this processor has gives bitwise the same velocities
+        use super::ewald::simd::Simd;
+        for simd in [Simd::Plain, Simd::Avx2, Simd::Avx512] {
+            if simd == Simd::Plain || Simd::detect() == simd || Simd::detect() == Simd::Avx512 {
+                let mut v = vec![0.0; f.len()];
+                wave.apply_add_with(&f, &mut v, simd);
+                assert_eq!(v, fast, "{simd:?}");
+            }
+        }
     }
 }
 

@@ -286,3 +286,111 @@ fn ewald_prepare_profile() {
     let op = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
     eprintln!("{:?}", op.summary());
 }
+
+#[test]
+#[ignore = "probe: cargo test --release -p magsep-systems --lib support_error_probe -- --ignored --nocapture"]
+fn support_error_probe() {
+    // product error against the dense product (200 polydisperse particles with overlaps, as
+    // `product_matches_dense_rpy_to_tolerance`) and, at N = 10⁴ (τ = 1e-4, the chosen
+    // cut-off), against the direct sum, for supports ⌈2w/h⌉ + extra
+    let rel = |a: &[f64], b: &[f64]| {
+        let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+        (dot(&d, &d) / dot(b, b)).sqrt()
+    };
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    let (pos, radii) = random_config(&mut rng, 200, 12.0 * super::tests::A, true);
+    let f = flat(&normals(
+        &mut Xoshiro256PlusPlus::seed_from_u64(1),
+        pos.len(),
+    ));
+    let mut exact = vec![0.0; f.len()];
+    rpy::DenseSym::rpy(&pos, &radii, ETA).matvec(&f, &mut exact);
+    let mut v = vec![0.0; f.len()];
+    for extra in [0, 1, 2] {
+        for tol in [1e-2, 1e-4, 1e-6, 1e-8] {
+            for rc in [3.0, 4.0, 5.0] {
+                let rc = rc * super::tests::A;
+                let op =
+                    SpectralEwald::with_cutoff_support(&pos, &radii, ETA, tol, Some(rc), extra)
+                        .unwrap();
+                op.apply(&f, &mut v);
+                eprintln!(
+                    "extra {extra} tol {tol:e} rc/a {:.0} support {}: error {:.3e} = tol/{:.1}",
+                    rc / super::tests::A,
+                    op.summary().support,
+                    rel(&v, &exact),
+                    tol / rel(&v, &exact)
+                );
+            }
+        }
+    }
+    let (n, a) = (10_000, 75e-9);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
+    let f = flat(&normals(&mut rng, n));
+    let direct = SpectralEwald::with_cutoff(&pos, &radii, ETA, 1e-4, None).unwrap();
+    let mut exact = vec![0.0; 3 * n];
+    direct.apply(&f, &mut exact);
+    let rc = SpectralEwald::new(&pos, &radii, ETA, 1e-4)
+        .unwrap()
+        .summary()
+        .cutoff;
+    let mut v = vec![0.0; 3 * n];
+    for extra in [0, 1, 2] {
+        let op =
+            SpectralEwald::with_cutoff_support(&pos, &radii, ETA, 1e-4, Some(rc), extra).unwrap();
+        op.apply(&f, &mut v);
+        eprintln!(
+            "N = 10^4, tol 1e-4, extra {extra}: error {:.3e}; {:?}",
+            rel(&v, &exact),
+            op.summary()
+        );
+    }
+}
+
+#[test]
+#[ignore = "probe: cargo test --release -p magsep-systems --lib prepare_parts_timing -- --ignored --nocapture"]
+fn prepare_parts_timing() {
+    // the parts of one N = 10⁴ preparation (kernel cached), medians of 5, 1 and 2 threads
+    use super::ewald::near::Near;
+    use super::ewald::params::Params;
+    use super::ewald::wave::Wave;
+    use std::time::Instant;
+    let (n, a) = (10_000, 75e-9);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let (pos, radii) = dilute_suspension(&mut rng, n, a);
+    let _ = SpectralEwald::new(&pos, &radii, ETA, 1e-4).unwrap();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut t = vec![Vec::new(); 5];
+            for _ in 0..5 {
+                let c = Instant::now();
+                let p = Params::choose(1e-4, &pos, &radii, 12.0).unwrap();
+                t[0].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let near = Near::new(&p, &pos, &radii, ETA);
+                t[1].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let wave = Wave::new(&p, &pos, &radii, 1.0);
+                t[2].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                let pc = precond::ClusterFactor::new(&pos, &radii, ETA);
+                t[3].push(c.elapsed().as_secs_f64());
+                let c = Instant::now();
+                drop((near, wave, pc));
+                t[4].push(c.elapsed().as_secs_f64());
+            }
+            for v in &mut t {
+                v.sort_by(f64::total_cmp);
+            }
+            eprintln!(
+                "threads {threads}: params {:.4} s, near {:.4} s, wave {:.4} s, cluster factor {:.4} s, drop {:.4} s",
+                t[0][2], t[1][2], t[2][2], t[3][2], t[4][2]
+            );
+        });
+    }
+}

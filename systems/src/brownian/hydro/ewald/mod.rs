@@ -76,6 +76,7 @@ pub(crate) mod fft3;
 pub(crate) mod kernels;
 pub(crate) mod near;
 pub mod params;
+pub(crate) mod simd;
 pub(crate) mod wave;
 
 use glam::DVec3;
@@ -134,6 +135,22 @@ impl SpectralEwald {
     ) -> Result<Self, HydroError> {
         check_tolerance(tolerance)?;
         let params = Params::with_cutoff(tolerance, cutoff, positions, radii);
+        Ok(Self::with_params(params, positions, radii, viscosity))
+    }
+
+    /// As [`SpectralEwald::with_cutoff`] with the Gaussian support widened by `extra` points
+    /// (the probe of the error against the support).
+    #[cfg(test)]
+    pub fn with_cutoff_support(
+        positions: &[DVec3],
+        radii: &[f64],
+        viscosity: f64,
+        tolerance: f64,
+        cutoff: Option<f64>,
+        extra: usize,
+    ) -> Result<Self, HydroError> {
+        check_tolerance(tolerance)?;
+        let params = Params::with_cutoff_support(tolerance, cutoff, positions, radii, extra);
         Ok(Self::with_params(params, positions, radii, viscosity))
     }
 
@@ -207,8 +224,9 @@ pub struct EwaldSummary {
     pub grid: usize,
     /// Gaussian support P (points per side)
     pub support: usize,
-    /// stored real-space pair blocks (each pair twice; for the direct sum only the
-    /// overlapping pairs, the others are evaluated on the fly)
+    /// real-space pair blocks of the operator (each pair counted twice, once per row, and
+    /// stored once; for the direct sum only the overlapping pairs, the others are evaluated
+    /// on the fly)
     pub pair_blocks: usize,
 }
 

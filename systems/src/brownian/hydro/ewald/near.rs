@@ -16,20 +16,27 @@ use super::params::Params;
 use crate::brownian::cells::CellList;
 use crate::brownian::hydro::rpy::{rpy_coefficients, self_mobility};
 
-/// Rows per parallel task.
+/// Fixed row chunks of the product (each with its own partial output, summed in chunk
+/// order: the same result for every thread count).
+const CHUNKS: usize = 8;
+
+/// Rows per parallel task of the final sum.
 const ROWS: usize = 64;
 
-/// CSR block matrix: row i's blocks are `blocks[start[i]..start[i + 1]]` with columns `cols`;
-/// blocks stored as (iso, dyad factor f) with block = iso I + f d dᵀ, d = x_i − x_j recomputed
-/// from the stored positions in every product (the same bits as when the block was made;
-/// 20 instead of 44 bytes per block read per product).
+/// Upper block rows: row i holds the pairs (i, j), j > i, each stored once as (iso, dyad
+/// factor f) with block = iso I + f d dᵀ, d = x_i − x_j recomputed from the stored positions
+/// in every product (the same bits as when the block was made; 20 bytes per pair read per
+/// product). The product uses each block for both rows, B x_j into row i and B x_i into
+/// row j (the blocks are symmetric).
 #[derive(Debug)]
 pub(crate) struct Near {
-    start: Vec<usize>,
-    cols: Vec<u32>,
-    blocks: Vec<(f64, f64)>,
+    rows: Vec<Row>,
+    /// first row of each chunk (and n at the end): about equal pair counts per chunk
+    bounds: Vec<usize>,
     diag: Vec<f64>,
     positions: Vec<DVec3>,
+    /// the chunks' partial outputs (CHUNKS × 3N), reused across products
+    partial: std::sync::Mutex<Vec<f64>>,
 }
 
 /// One row of the pair list: columns and blocks.
@@ -62,14 +69,16 @@ fn pair(r: f64, a_i: f64, a_j: f64, viscosity: f64, xi: f64) -> (f64, f64) {
 
 impl Near {
     /// Builds the blocks for `params` (cut-off, ξ). Each pair's block is computed once (for
-    /// j > i, in parallel over rows) and mirrored into row j (the block is symmetric: same r,
-    /// same s = a_i² + a_j²); row i holds first its columns k < i in increasing k, then its
-    /// columns j > i in the cell list's order, independent of the thread count.
+    /// j > i, in parallel over rows, columns in the cell list's order, independent of the
+    /// thread count) and serves both rows (the block is symmetric: same r, same
+    /// s = a_i² + a_j²).
     pub fn new(params: &Params, positions: &[DVec3], radii: &[f64], viscosity: f64) -> Self {
         let n = positions.len();
         let xi = params.xi;
-        let cells =
-            (!params.is_direct()).then(|| CellList::build(positions, params.cutoff, |_| true));
+        // cells of edge r_c/2 searched two to each side: 3.8 instead of 6.4 candidates per
+        // pair within the cut-off
+        let cells = (!params.is_direct())
+            .then(|| CellList::build_with_reach(positions, params.cutoff, 2, |_| true));
         let upper: Vec<Row> = (0..n)
             .into_par_iter()
             .with_min_len(ROWS)
@@ -106,98 +115,107 @@ impl Near {
                 self_mobility(a, viscosity) - pre * wave
             })
             .collect();
-        let (start, cols, blocks) = mirror(&upper);
+        let total: usize = upper.iter().map(|r| r.0.len()).sum();
+        let mut bounds = vec![0];
+        let mut seen = 0;
+        for (i, r) in upper.iter().enumerate() {
+            // cut before row i once the running count reaches the next chunk's share
+            if bounds.len() < CHUNKS && seen * CHUNKS >= total * bounds.len() && seen > 0 {
+                bounds.push(i);
+            }
+            seen += r.0.len();
+        }
+        bounds.resize(CHUNKS, n);
+        bounds.push(n);
         Self {
-            start,
-            cols,
-            blocks,
+            rows: upper,
+            bounds,
             diag,
             positions: positions.to_vec(),
+            partial: std::sync::Mutex::new(Vec::new()),
         }
     }
 
-    /// Number of stored pair blocks (each pair twice).
+    /// Number of pair blocks of the operator (each pair twice, once per row; stored once).
     pub fn pairs(&self) -> usize {
-        self.cols.len()
+        2 * self.rows.iter().map(|r| r.0.len()).sum::<usize>()
     }
 
     /// out = near-field product of the flat force vector `x` (3N).
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        let n3 = out.len();
         #[cfg(target_arch = "x86_64")]
         let avx2 = std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("fma");
+        // the buffers of the previous product (a fresh set if another product holds them)
+        let mut guard = self.partial.try_lock().ok();
+        let mut fresh = Vec::new();
+        let partial = match guard.as_deref_mut() {
+            Some(p) => p,
+            None => &mut fresh,
+        };
+        partial.clear();
+        partial.resize(CHUNKS * n3, 0.0);
+        partial
+            .par_chunks_mut(n3.max(1))
+            .enumerate()
+            .for_each(|(c, part)| {
+                #[cfg(target_arch = "x86_64")]
+                if avx2 {
+                    // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
+                    unsafe { self.chunk_avx2(c, part, x) };
+                    return;
+                }
+                self.chunk(c, part, x);
+            });
+        let partial = &*partial;
         out.par_chunks_mut(3 * ROWS).enumerate().for_each(|(k, o)| {
-            #[cfg(target_arch = "x86_64")]
-            if avx2 {
-                // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
-                unsafe { self.rows_avx2(k, o, x) };
-                return;
+            for (r, oi) in o.iter_mut().enumerate() {
+                let e = 3 * k * ROWS + r;
+                let mut acc = x[e] * self.diag[e / 3];
+                for c in 0..CHUNKS {
+                    acc += partial[c * n3 + e];
+                }
+                *oi = acc;
             }
-            self.rows(k, o, x);
         });
     }
 
-    /// [`Near::rows`] compiled for AVX2 (bitwise the same result).
+    /// [`Near::chunk`] compiled for AVX2 (bitwise the same result).
     ///
     /// # Safety
     /// The processor must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn rows_avx2(&self, k: usize, o: &mut [f64], x: &[f64]) {
-        self.rows(k, o, x);
+    unsafe fn chunk_avx2(&self, c: usize, part: &mut [f64], x: &[f64]) {
+        self.chunk(c, part, x);
     }
 
-    /// Rows `k ROWS ..` of the product into `o`.
+    /// The pairs of chunk `c`'s rows added into its partial output `part` (3N, zero on entry).
     #[inline(always)]
-    fn rows(&self, k: usize, o: &mut [f64], x: &[f64]) {
-        for (r, oi) in o.chunks_exact_mut(3).enumerate() {
-            let i = k * ROWS + r;
-            let mut acc = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]) * self.diag[i];
-            let xi = self.positions[i];
-            for b in self.start[i]..self.start[i + 1] {
-                let j = self.cols[b] as usize;
-                let (iso, f) = self.blocks[b];
-                let d = xi - self.positions[j];
+    fn chunk(&self, c: usize, part: &mut [f64], x: &[f64]) {
+        for i in self.bounds[c]..self.bounds[c + 1] {
+            let (cols, blocks) = &self.rows[i];
+            let pi = self.positions[i];
+            let fi = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+            let mut acc = DVec3::ZERO;
+            for (&j, &(iso, f)) in cols.iter().zip(blocks) {
+                let j = j as usize;
+                let d = pi - self.positions[j];
                 let xj = DVec3::new(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
                 acc += xj * iso + d * (f * d.dot(xj));
+                let v = fi * iso + d * (f * d.dot(fi));
+                let o = &mut part[3 * j..3 * j + 3];
+                o[0] += v.x;
+                o[1] += v.y;
+                o[2] += v.z;
             }
-            oi.copy_from_slice(&[acc.x, acc.y, acc.z]);
+            let o = &mut part[3 * i..3 * i + 3];
+            o[0] += acc.x;
+            o[1] += acc.y;
+            o[2] += acc.z;
         }
     }
-}
-
-/// The full CSR (start, columns, blocks) from the upper rows (columns j > i): row i gets the
-/// mirrored blocks of every earlier row k that lists i (increasing k), then its own.
-fn mirror(upper: &[Row]) -> (Vec<usize>, Vec<u32>, Vec<(f64, f64)>) {
-    let n = upper.len();
-    let mut lower = vec![0usize; n];
-    for (cols, _) in upper {
-        for &j in cols {
-            lower[j as usize] += 1;
-        }
-    }
-    let mut start = Vec::with_capacity(n + 1);
-    start.push(0);
-    for (i, (cols, _)) in upper.iter().enumerate() {
-        start.push(start[i] + lower[i] + cols.len());
-    }
-    let total = start[n];
-    let mut out_cols = vec![0u32; total];
-    let mut out_blocks = vec![(0.0, 0.0); total];
-    // cursor of the next mirrored entry per row
-    let mut cursor: Vec<usize> = start[..n].to_vec();
-    for (k, (cols, blocks)) in upper.iter().enumerate() {
-        let own = start[k] + lower[k];
-        out_cols[own..own + cols.len()].copy_from_slice(cols);
-        out_blocks[own..own + cols.len()].copy_from_slice(blocks);
-        for (&j, &b) in cols.iter().zip(blocks) {
-            let c = &mut cursor[j as usize];
-            out_cols[*c] = k as u32;
-            out_blocks[*c] = b;
-            *c += 1;
-        }
-    }
-    (start, out_cols, out_blocks)
 }
 
 #[cfg(test)]
@@ -215,7 +233,7 @@ mod tests {
 
     /// Every 3×3 block of the operator (read column by column through `apply`) equals the
     /// pair block computed directly for that pair (zero beyond the cut-off), with the
-    /// diagonal's self term: the mirrored half list stores each pair in both rows.
+    /// diagonal's self term: the half list (each pair stored once) serves both rows.
     #[test]
     fn mirrored_blocks_equal_the_pair_blocks_in_both_rows() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);

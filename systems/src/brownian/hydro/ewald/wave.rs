@@ -23,6 +23,7 @@ use std::sync::{Arc, Mutex};
 use super::fft3::{ConvScratch, Fft3};
 use super::kernels::{smoothed_laplacian, wave_stokeslet};
 use super::params::Params;
+use super::simd::Simd;
 
 /// Symmetric 3×3 kernel at one wavenumber: xx, yy, zz, xy, xz, yz (real: the sampled
 /// kernels are even).
@@ -122,18 +123,6 @@ fn kernel_spectrum(
         }
     }
     out
-}
-
-/// True when the processor has AVX2 and FMA (the wide spreading and gathering).
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 #[inline]
@@ -247,24 +236,45 @@ impl Wave {
         &self,
         src: &(dyn Fn(usize, usize) -> f64 + Sync),
         grid: &mut Vec<f64>,
+        simd: Simd,
     ) {
         let (m, p) = (self.fft.m, self.support);
         grid.clear();
         grid.resize(m * m * m * NF, 0.0);
-        let avx2 = has_avx2();
         grid.par_chunks_mut(m * m * NF)
             .enumerate()
             .for_each(|(ix, plane)| {
                 let mut t = vec![0.0; p * NF];
                 #[cfg(target_arch = "x86_64")]
-                if avx2 {
-                    // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
-                    unsafe { self.spread_plane_avx2::<NF>(ix, plane, &mut t, src) };
-                    return;
+                match simd {
+                    // SAFETY: `detect` reports AVX-512 F/DQ/VL (and AVX2, FMA) only when
+                    // the processor has them
+                    Simd::Avx512 => unsafe {
+                        self.spread_plane_avx512::<NF>(ix, plane, &mut t, src)
+                    },
+                    // SAFETY: as above, AVX2 and FMA
+                    Simd::Avx2 => unsafe { self.spread_plane_avx2::<NF>(ix, plane, &mut t, src) },
+                    Simd::Plain => self.spread_plane::<NF>(ix, plane, &mut t, src),
                 }
-                let _ = avx2;
+                #[cfg(not(target_arch = "x86_64"))]
                 self.spread_plane::<NF>(ix, plane, &mut t, src);
             });
+    }
+
+    /// [`Wave::spread_plane`] compiled for AVX-512 (bitwise the same result).
+    ///
+    /// # Safety
+    /// The processor must support AVX-512 F, DQ and VL, AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512dq,avx512vl")]
+    unsafe fn spread_plane_avx512<const NF: usize>(
+        &self,
+        ix: usize,
+        plane: &mut [f64],
+        t: &mut [f64],
+        src: &(dyn Fn(usize, usize) -> f64 + Sync),
+    ) {
+        self.spread_plane::<NF>(ix, plane, t, src);
     }
 
     /// [`Wave::spread_plane`] compiled for AVX2 (the same operations on wider vectors,
@@ -326,14 +336,35 @@ impl Wave {
         grid: &[f64],
         i: usize,
         acc: &mut [f64],
-        avx2: bool,
+        simd: Simd,
     ) -> [f64; NF] {
         #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: `avx2` is true only when the processor has AVX2 and FMA
-            return unsafe { self.gather_avx2::<NF>(grid, i, acc) };
+        match simd {
+            // SAFETY: `simd` comes from `Simd::detect`: the processor has these features
+            Simd::Avx512 => unsafe { self.gather_avx512::<NF>(grid, i, acc) },
+            // SAFETY: as above
+            Simd::Avx2 => unsafe { self.gather_avx2::<NF>(grid, i, acc) },
+            Simd::Plain => self.gather_plain::<NF>(grid, i, acc),
         }
-        let _ = avx2;
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = simd;
+            self.gather_plain::<NF>(grid, i, acc)
+        }
+    }
+
+    /// [`Wave::gather_plain`] compiled for AVX-512 (bitwise the same result).
+    ///
+    /// # Safety
+    /// The processor must support AVX-512 F, DQ and VL, AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512dq,avx512vl")]
+    unsafe fn gather_avx512<const NF: usize>(
+        &self,
+        grid: &[f64],
+        i: usize,
+        acc: &mut [f64],
+    ) -> [f64; NF] {
         self.gather_plain::<NF>(grid, i, acc)
     }
 
@@ -472,8 +503,13 @@ impl Wave {
 
     /// Adds the wave-space velocities of the forces `f` (flat, 3N) to `out` (flat, 3N).
     pub fn apply_add(&self, f: &[f64], out: &mut [f64]) {
+        self.apply_add_with(f, out, Simd::detect());
+    }
+
+    /// [`Wave::apply_add`] with spreading and gathering compiled for `simd` (which the
+    /// processor must support: a level from [`Simd::detect`] or below).
+    pub fn apply_add_with(&self, f: &[f64], out: &mut [f64], simd: Simd) {
         let p = self.support;
-        let avx2 = has_avx2();
         // the buffers of the previous product (a fresh set if another product holds them)
         let mut guard = self.scratch.try_lock().ok();
         let mut fresh = WaveScratch::default();
@@ -482,22 +518,22 @@ impl Wave {
             None => &mut fresh,
         };
         if self.kernel_l.is_some() {
-            self.spread::<6>(&|i, c| self.source(f, i, c), grid);
+            self.spread::<6>(&|i, c| self.source(f, i, c), grid, simd);
             self.convolve_into(grid, 6, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 6 * p],
                 |acc, (i, o)| {
-                    let v = self.combine(&self.gather::<6>(field, i, acc, avx2), i);
+                    let v = self.combine(&self.gather::<6>(field, i, acc, simd), i);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
         } else {
-            self.spread::<3>(&|i, c| f[3 * i + c], grid);
+            self.spread::<3>(&|i, c| f[3 * i + c], grid, simd);
             self.convolve_into(grid, 3, field, conv);
             out.par_chunks_mut(3).enumerate().for_each_init(
                 || vec![0.0; 3 * p],
                 |acc, (i, o)| {
-                    let v = self.gather::<3>(field, i, acc, avx2);
+                    let v = self.gather::<3>(field, i, acc, simd);
                     o.iter_mut().zip(v).for_each(|(o, v)| *o += v);
                 },
             );
