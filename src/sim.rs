@@ -14,6 +14,7 @@ use magsep_plugins::record::{
     FibreShape, FrameBuffering, PluginInfo, RecordingMetadata, RecordingWriter,
 };
 use magsep_plugins::recorder::{Recorder, record_now, recording_error};
+use magsep_systems::forces::ForceComponents;
 use serde_json::Value;
 
 pub use crate::error::SimError;
@@ -159,6 +160,10 @@ impl Simulation {
         group.build(&mut app);
         for p in &options.plugins {
             app.add_boxed_plugin(p.clone());
+        }
+        if options.plugins.is_empty() && options.pipeline.is_none() {
+            // only the pipeline's own systems run: nothing reads the force components
+            app.world.insert_resource(ForceComponents::WorkspaceOnly);
         }
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
         if let Some(path) = &options.record {

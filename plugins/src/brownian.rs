@@ -19,13 +19,17 @@
 //! component) is a value of the step start: the integrator consumes it only with
 //! `step_control = fixed` (explicit Euler evaluates forces only there) and `SimApp::finish`
 //! refuses it with adaptive steps, naming the kernel alternative (see [`brownian_force_use`]).
+//! The component copies and the contribution passes run only while something may read them
+//! ([`force_components_written`]: by default always; `magsep`'s scene driver keeps the
+//! forces in the workspace when the run has no plugin besides the pipeline's, see
+//! `magsep_systems::forces::ForceComponents`).
 //! The forces plugin's `finish` hook gathers the particles into the dense workspace
 //! (resources `BrownianConfig`, `ExternalField`, `StepClock` must exist).
 
 use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_systems::brownian::systems::*;
-use magsep_systems::forces::{Consumption, ForceUse};
+use magsep_systems::forces::{Consumption, ContributionPasses, ForceUse};
 use magsep_systems::sets::{ForceSystems, SimSystems};
 
 use crate::app::{SimApp, SimPlugin};
@@ -45,10 +49,17 @@ impl SimPlugin for BrownianForcesPlugin {
         app.register_force::<ContactForce>();
         app.schedule.add_systems((
             prepare_brownian_step.in_set(SimSystems::Prepare),
-            compute_field_forces.in_set(ForceSystems::Field),
-            compute_dipole_forces.in_set(ForceSystems::Dipole),
-            compute_contact_forces.in_set(ForceSystems::Contact),
+            (
+                compute_field_forces.in_set(ForceSystems::Field),
+                compute_dipole_forces.in_set(ForceSystems::Dipole),
+                compute_contact_forces.in_set(ForceSystems::Contact),
+            )
+                .run_if(force_components_written),
         ));
+        // the generic clear and sum passes of the contributions serve only readers outside
+        // the pipeline when the integrator takes its forces from the workspace
+        app.schedule
+            .configure_sets(ContributionPasses.run_if(force_components_written));
     }
 
     fn finish(&self, world: &mut World) {

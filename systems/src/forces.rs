@@ -55,6 +55,32 @@ pub struct ForceRegistry {
     pub names: Vec<String>,
 }
 
+/// The set of every generic contribution pass ([`clear_contribution`], [`clear_net_force`],
+/// [`add_contribution`]): a pipeline that keeps its forces in a dense workspace can skip them
+/// all with one run condition (see [`ForceComponents`]).
+#[derive(bevy_ecs::schedule::SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ContributionPasses;
+
+/// Whether the force contribution components (and `NetForce`) must be kept up to date at every
+/// step (a resource; absent means [`ForceComponents::EveryStep`]).
+///
+/// A pipeline whose integrator reads its forces from a dense workspace (the brownian one)
+/// honours [`ForceComponents::WorkspaceOnly`] while its own contributions are the only ones
+/// registered: it then skips writing them to the components and the contribution passes,
+/// which only readers outside the pipeline would see. `magsep`'s scene driver asks for it when
+/// the run has no plugin besides the pipeline's own (the recorder reads positions, never
+/// forces); an app whose systems read the forces keeps the default, and inserting
+/// `EveryStep` at any time brings the components back from the next step on.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ForceComponents {
+    /// Written every step.
+    #[default]
+    EveryStep,
+    /// Kept only in the pipeline's workspace where the pipeline can (the components keep
+    /// their last written values).
+    WorkspaceOnly,
+}
+
 /// Marker set of the `n`-th accumulation system (to chain them).
 #[derive(bevy_ecs::schedule::SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct AccumulateSlot(pub usize);
@@ -94,6 +120,7 @@ impl ForceRegistry {
             schedule.add_systems(
                 clear_net_force
                     .in_set(SimSystems::Accumulate)
+                    .in_set(ContributionPasses)
                     .before(AccumulateSlot(0)),
             );
         }
@@ -101,10 +128,13 @@ impl ForceRegistry {
         if n > 0 {
             schedule.configure_sets(AccumulateSlot(n).after(AccumulateSlot(n - 1)));
         }
-        schedule.add_systems((
-            clear_contribution::<T>.in_set(SimSystems::Prepare),
-            add_contribution::<T>.in_set(AccumulateSlot(n)),
-        ));
+        schedule.add_systems(
+            (
+                clear_contribution::<T>.in_set(SimSystems::Prepare),
+                add_contribution::<T>.in_set(AccumulateSlot(n)),
+            )
+                .in_set(ContributionPasses),
+        );
         self.names.push(name);
     }
 }

@@ -219,6 +219,61 @@ fn the_fixed_step_is_bitwise_identical_for_one_and_two_threads() {
     );
 }
 
+/// The forces kept in the workspace only (what a scene run without extra plugins asks for)
+/// and written to the components at every step give bitwise the same trajectory, on one and
+/// two threads; only the second fills the components.
+#[test]
+fn forces_in_the_workspace_only_give_the_trajectory_of_forces_in_components() {
+    use magsep_components::prelude::{DipoleForce, NetForce};
+    use magsep_systems::forces::ForceComponents;
+    let s = scene(&magsep::studies::bench_brownian::lammps_mirror_scene(9, 5).unwrap());
+    let run = |threads: usize, every_step: bool| {
+        on_threads(threads, || {
+            let options = RunOptions {
+                single_threaded: true,
+                ..Default::default()
+            };
+            let mut sim = Simulation::from_scene(&s, options).unwrap();
+            assert_eq!(
+                sim.app.world.get_resource::<ForceComponents>(),
+                Some(&ForceComponents::WorkspaceOnly)
+            );
+            if every_step {
+                sim.app.world.insert_resource(ForceComponents::EveryStep);
+            }
+            for _ in 0..30 {
+                sim.step();
+            }
+            let written = sim
+                .app
+                .world
+                .query::<(&DipoleForce, &NetForce)>()
+                .iter(&sim.app.world)
+                .filter(|(d, f)| d.0 != glam::DVec3::ZERO && f.0 != glam::DVec3::ZERO)
+                .count();
+            (positions(&mut sim), written)
+        })
+    };
+    let bits = |x: &[glam::DVec3]| -> Vec<[u64; 3]> {
+        x.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    };
+    let (a, written_a) = run(1, false);
+    let (b, written_b) = run(1, true);
+    let (c, _) = run(2, false);
+    let (d, _) = run(2, true);
+    assert_eq!(
+        written_a, 0,
+        "workspace only: the components keep their defaults"
+    );
+    assert!(written_b > a.len() / 2, "{written_b} of {}", a.len());
+    assert!(
+        bits(&a) == bits(&b),
+        "workspace only vs components, 1 thread"
+    );
+    assert!(bits(&a) == bits(&c), "1 vs 2 threads, workspace only");
+    assert!(bits(&a) == bits(&d), "1 vs 2 threads, components");
+}
+
 fn identical_for_one_and_two_threads(kind: &str) {
     let s = scene(&dense_scene(&format!(
         r#"{{ kind = "{kind}", tolerance = 1e-3, max_displacement = 0.2, max_depth = 24 }}"#

@@ -217,6 +217,24 @@ impl ForceModel {
         field: &mut [DVec3],
     ) {
         patches.ensure(x.len());
+        if self.sources.is_empty() {
+            // uniform field: a moment depends on the particle's law alone (and no field
+            // force), so consecutive particles of one law share one evaluation
+            let mut last: Option<(MomentModel, DVec3)> = None;
+            for (i, (m, f)) in moments.iter_mut().zip(field.iter_mut()).enumerate() {
+                let law = view.moments[i];
+                *m = match last {
+                    Some((l, v)) if l == law => v,
+                    _ => {
+                        let v = self.moment_and_field_force(x, view, i, &mut None).0;
+                        last = Some((law, v));
+                        v
+                    }
+                };
+                *f = DVec3::ZERO;
+            }
+            return;
+        }
         let go = |(i, ((m, f), slot)): (usize, ((&mut DVec3, &mut DVec3), &mut Option<Patch>))| {
             (*m, *f) = self.moment_and_field_force(x, view, i, slot);
         };

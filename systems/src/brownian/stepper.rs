@@ -67,7 +67,7 @@ pub trait Dynamics {
 
 /// Draw one standard-normal vector.
 #[inline]
-fn normal3(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
+pub fn normal3(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
     DVec3::new(
         StandardNormal.sample(rng),
         StandardNormal.sample(rng),

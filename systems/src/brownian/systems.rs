@@ -4,7 +4,7 @@
 //!
 //! | set | system | reads | writes |
 //! |---|---|---|---|
-//! | `Prepare` | [`prepare_brownian_step`] | | `BrownianWorkspace` (moments, field forces, cells) |
+//! | `Prepare` | [`prepare_brownian_step`] | | `BrownianWorkspace` (moments, lists, the three forces) |
 //! | `Forces::Field` | [`compute_field_forces`] | `BrownianWorkspace` | `FieldForce`, `MagneticMoment` |
 //! | `Forces::Dipole` | [`compute_dipole_forces`] | `BrownianWorkspace` | `DipoleForce` |
 //! | `Forces::Contact` | [`compute_contact_forces`] | `BrownianWorkspace` | `ContactForce` |
@@ -12,6 +12,16 @@
 //! | `Integrate` | [`integrate_brownian`] | forces, `StepClock` | `BrownianWorkspace`, `BrownianStats`, `Health` |
 //! | `Finalize::WriteBack` | [`write_back_brownian`] | `BrownianWorkspace` | `Position`, `Captured`, `ParticleRng` |
 //! | `Observe` | [`observe_capture`] | `BrownianWorkspace` | `CaptureCurve` |
+//!
+//! **Where the forces live.** The workspace holds every force of the step start; the three
+//! `Forces` systems only copy them to the components, and the integrator reads `NetForce`.
+//! With [`ForceComponents::WorkspaceOnly`] and no contribution registered besides the three
+//! (no user `ForceContribution`, no kernel), nothing outside the pipeline needs them: the copies,
+//! the generic contribution passes and the read of `NetForce` are skipped
+//! ([`force_components_written`]), and the integrator sums the workspace's forces in the
+//! order of the accumulation, so the trajectory is bitwise the same either way (tested in
+//! `tests/it/brownian_pipeline.rs`). Positions, capture flags and random streams are
+//! written back at every step.
 //!
 //! **Threads.** The numerical kernels run on the rayon pool; the component passes (writing the
 //! forces, reading `NetForce` back, the write-back) run on the system's thread
@@ -29,10 +39,10 @@ use super::fibre_flow::{FibreFlow, FlowFibre};
 use super::hydro::{Mobility, MobilityMethod, MobilityOptions, auto_method};
 use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
-use super::stepper::advance;
 use super::stepper::multirate::advance_multirate;
+use super::stepper::{PARTICLE_CHUNK, advance};
 use crate::field::CylinderSource;
-use crate::forces::ExternalForces;
+use crate::forces::{ExternalForces, ForceComponents, ForceRegistry};
 
 use super::passes::{in_workspace_order, write_dense};
 use magsep_components::forces::KernelForce;
@@ -63,6 +73,10 @@ pub struct BrownianWorkspace {
     pub moments: Vec<DVec3>,
     /// Field forces at the step start \[N\].
     pub field: Vec<DVec3>,
+    /// Dipole-dipole forces at the step start \[N\].
+    pub dipole: Vec<DVec3>,
+    /// Contact forces at the step start \[N\].
+    pub contact: Vec<DVec3>,
     /// Neighbour lists of the pair forces (cached across steps).
     pub lists: PairLists,
     /// Mobility of this step (None: free draining).
@@ -198,6 +212,8 @@ pub fn init_brownian_workspace(world: &mut World) {
         shapes: rows.iter().map(|r| r.7).collect(),
         moments: vec![DVec3::ZERO; rows.len()],
         field: vec![DVec3::ZERO; rows.len()],
+        dipole: vec![DVec3::ZERO; rows.len()],
+        contact: vec![DVec3::ZERO; rows.len()],
         laws: rows.iter().map(|r| r.4).collect(),
         captured: rows.iter().map(|r| r.5).collect(),
         rngs: rows.iter().map(|r| r.6.clone()).collect(),
@@ -232,8 +248,25 @@ pub fn init_brownian_workspace(world: &mut World) {
     }
 }
 
-/// Moments, field forces (one field evaluation per particle) and the neighbour lists at the
-/// step start.
+/// Whether the force components and `NetForce` are kept up to date this step (a run
+/// condition of the component passes, see the module header): unless
+/// [`ForceComponents::WorkspaceOnly`] was asked for and the registry holds only the
+/// pipeline's own three contributions.
+pub fn force_components_written(
+    wanted: Option<Res<ForceComponents>>,
+    registry: Option<Res<ForceRegistry>>,
+) -> bool {
+    let own = [
+        std::any::type_name::<FieldForce>(),
+        std::any::type_name::<DipoleForce>(),
+        std::any::type_name::<ContactForce>(),
+    ];
+    wanted.is_none_or(|w| *w == ForceComponents::EveryStep)
+        || registry.is_some_and(|r| r.names.iter().any(|n| !own.contains(&n.as_str())))
+}
+
+/// Moments, field forces (one field evaluation per particle), the neighbour lists and the
+/// pair forces at the step start.
 pub fn prepare_brownian_step(
     mut ws: ResMut<BrownianWorkspace>,
     config: Res<BrownianConfig>,
@@ -259,6 +292,17 @@ pub fn prepare_brownian_step(
         .moments_and_field(&ws.positions, &view, &mut ws.lists.patches, &mut m, &mut f);
     (ws.moments, ws.field) = (m, f);
     stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
+    let (mut d, mut c) = (
+        std::mem::take(&mut ws.dipole),
+        std::mem::take(&mut ws.contact),
+    );
+    d.resize(n, DVec3::ZERO);
+    c.resize(n, DVec3::ZERO);
+    ws.model
+        .dipole_forces(&ws.positions, &ws.moments, &view, &ws.lists, &mut d);
+    ws.model
+        .contact_forces(&ws.positions, &view, &ws.lists, &mut c);
+    (ws.dipole, ws.contact) = (d, c);
 }
 
 /// Field forces and moments (computed in `Prepare` with the moments the dipole forces need).
@@ -271,47 +315,20 @@ pub fn compute_field_forces(
     write_dense(&ws.entities, &ws.moments, &mut moments, |c, v| c.0 = v);
 }
 
-/// Evaluate one pair-force kernel over the workspace into `out` (a dense array).
-fn pair_forces(
-    ws: &BrownianWorkspace,
-    config: &BrownianConfig,
-    kernel: impl Fn(&ParticleView, &mut [DVec3]),
-) -> Vec<DVec3> {
-    let (mobile, exerts) = (ws.mobile(), ws.exerts(config));
-    let view = ParticleView {
-        radii: &ws.radii,
-        moments: &ws.laws,
-        mobile: &mobile,
-        exerts: &exerts,
-    };
-    let mut f = vec![DVec3::ZERO; ws.positions.len()];
-    kernel(&view, &mut f);
-    f
-}
-
-/// Dipole-dipole forces.
+/// Dipole-dipole forces (computed in `Prepare`).
 pub fn compute_dipole_forces(
     ws: Res<BrownianWorkspace>,
-    config: Res<BrownianConfig>,
     mut forces: Query<(Entity, &mut DipoleForce)>,
 ) {
-    let f = pair_forces(&ws, &config, |view, out| {
-        ws.model
-            .dipole_forces(&ws.positions, &ws.moments, view, &ws.lists, out)
-    });
-    write_dense(&ws.entities, &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws.entities, &ws.dipole, &mut forces, |c, v| c.0 = v);
 }
 
-/// Mie contact forces.
+/// Mie contact forces (computed in `Prepare`).
 pub fn compute_contact_forces(
     ws: Res<BrownianWorkspace>,
-    config: Res<BrownianConfig>,
     mut forces: Query<(Entity, &mut ContactForce)>,
 ) {
-    let f = pair_forces(&ws, &config, |view, out| {
-        ws.model.contact_forces(&ws.positions, view, &ws.lists, out)
-    });
-    write_dense(&ws.entities, &f, &mut forces, |c, v| c.0 = v);
+    write_dense(&ws.entities, &ws.contact, &mut forces, |c, v| c.0 = v);
 }
 
 /// Build this step's mobility over the free particles (nothing for free draining).
@@ -356,23 +373,21 @@ type ForceRow<'a> = (
     Option<&'a KernelForce>,
 );
 
-/// One step of the stepper from the accumulated forces. The step-start drift comes from
-/// `NetForce`; every sub-step re-evaluates the model forces and the external force kernels
-/// (the `KernelForce` part of `NetForce`) at its own positions and time, and holds the rest of
-/// `NetForce` (other registered contributions, accepted with fixed steps only) fixed.
-pub fn integrate_brownian(
-    mut ws: ResMut<BrownianWorkspace>,
-    config: Res<BrownianConfig>,
-    clock: Res<StepClock>,
-    mut stats: ResMut<BrownianStats>,
-    mut health: ResMut<Health>,
-    kernels: Option<Res<ExternalForces>>,
-    forces: Query<(Entity, ForceRow)>,
+/// The kernels, and whether and which force components are written.
+type ForceSources<'w> = (
+    Option<Res<'w, ExternalForces>>,
+    Option<Res<'w, ForceComponents>>,
+    Option<Res<'w, ForceRegistry>>,
+);
+
+/// `NetForce` of the workspace's particles into `net`, and into `extra` the part the model and
+/// the kernels do not account for (a user's contributions).
+fn read_net_force(
+    entities: &[Entity],
+    forces: &Query<(Entity, ForceRow)>,
+    net: &mut [DVec3],
+    extra: &mut [DVec3],
 ) {
-    let ws = &mut *ws;
-    let n = ws.positions.len();
-    let mut net = vec![DVec3::ZERO; n];
-    let mut extra = vec![DVec3::ZERO; n];
     let parts = |(f, a, b, c, kf): ForceRow| {
         let model = a.map(|v| v.0).unwrap_or_default()
             + b.map(|v| v.0).unwrap_or_default()
@@ -382,12 +397,40 @@ pub fn integrate_brownian(
     };
     let mut split = |k: usize, row: ForceRow| (net[k], extra[k]) = parts(row);
     // a linear pass while the query follows the workspace order, lookups for the rest
-    let k = in_workspace_order(&ws.entities, forces.iter(), &mut split);
-    for (k, e) in ws.entities.iter().enumerate().skip(k) {
+    let k = in_workspace_order(entities, forces.iter(), &mut split);
+    for (k, e) in entities.iter().enumerate().skip(k) {
         if let Ok((_, row)) = forces.get(*e) {
             split(k, row);
         }
     }
+}
+
+/// One step of the stepper from the accumulated forces. The step-start drift comes from
+/// `NetForce` (from the workspace's forces, summed in the accumulation's order, when the
+/// components are not written: [`force_components_written`]); every sub-step re-evaluates the model forces and the external force kernels
+/// (the `KernelForce` part of `NetForce`) at its own positions and time, and holds the rest of
+/// `NetForce` (other registered contributions, accepted with fixed steps only) fixed.
+pub fn integrate_brownian(
+    mut ws: ResMut<BrownianWorkspace>,
+    config: Res<BrownianConfig>,
+    clock: Res<StepClock>,
+    mut stats: ResMut<BrownianStats>,
+    mut health: ResMut<Health>,
+    forces: Query<(Entity, ForceRow)>,
+    (kernels, wanted, registry): ForceSources,
+) {
+    let ws = &mut *ws;
+    let n = ws.positions.len();
+    let mut extra = vec![DVec3::ZERO; n];
+    let from_components = force_components_written(wanted, registry);
+    let mut net = Vec::new();
+    if from_components {
+        net = vec![DVec3::ZERO; n];
+        read_net_force(&ws.entities, &forces, &mut net, &mut extra);
+    }
+    let (field, dipole, contact) = (&ws.field, &ws.dipole, &ws.contact);
+    // `NetForce` as the accumulation sums it: zero, then the contributions in order
+    let net_of = |k: usize| DVec3::ZERO + field[k] + dipole[k] + contact[k];
     let mut dynamics = PipelineDynamics {
         model: &ws.model,
         radii: &ws.radii,
@@ -416,33 +459,47 @@ pub fn integrate_brownian(
         sweeps: 0,
         failure: None,
     };
-    let mut v0 = vec![DVec3::ZERO; n];
     let mut x = std::mem::take(&mut ws.positions);
-    dynamics.velocities(&x, &net, &mut v0);
-    match config.step_control {
-        // multirate needs per-particle noise and drift: free draining, no hard cores
-        StepControl::Multirate {
-            tolerance,
-            max_displacement,
-            max_depth,
-        } if dynamics.hydro.is_none() && !dynamics.hard_core => advance_multirate(
-            &mut dynamics,
-            &mut x,
-            Some(v0),
-            clock.dt,
-            (tolerance, max_displacement, max_depth),
-            &mut ws.rngs,
-            &mut stats,
-        ),
-        _ => advance(
-            &mut dynamics,
-            &mut x,
-            Some(v0),
-            clock.dt,
-            &config.step_control,
-            &mut ws.rngs,
-            &mut stats,
-        ),
+    let fused = config.step_control == StepControl::Fixed
+        && dynamics.hydro.is_none()
+        && !dynamics.hard_core;
+    if fused {
+        if from_components {
+            dynamics.fixed_free_step(&mut x, |k| net[k], clock.dt, &mut ws.rngs, &mut stats);
+        } else {
+            dynamics.fixed_free_step(&mut x, net_of, clock.dt, &mut ws.rngs, &mut stats);
+        }
+    } else {
+        if !from_components {
+            net = (0..n).map(net_of).collect();
+        }
+        let mut v0 = vec![DVec3::ZERO; n];
+        dynamics.velocities(&x, &net, &mut v0);
+        match config.step_control {
+            // multirate needs per-particle noise and drift: free draining, no hard cores
+            StepControl::Multirate {
+                tolerance,
+                max_displacement,
+                max_depth,
+            } if dynamics.hydro.is_none() && !dynamics.hard_core => advance_multirate(
+                &mut dynamics,
+                &mut x,
+                Some(v0),
+                clock.dt,
+                (tolerance, max_displacement, max_depth),
+                &mut ws.rngs,
+                &mut stats,
+            ),
+            _ => advance(
+                &mut dynamics,
+                &mut x,
+                Some(v0),
+                clock.dt,
+                &config.step_control,
+                &mut ws.rngs,
+                &mut stats,
+            ),
+        }
     }
     let captures = std::mem::take(&mut dynamics.captures);
     stats.hard_core_sweeps += dynamics.sweeps;
@@ -462,34 +519,59 @@ pub fn integrate_brownian(
     ws.positions = x;
 }
 
-/// Copy positions, capture flags and random streams to the components.
+/// The particles' positions and capture flags (those with a random stream, like the
+/// workspace's).
+type PositionRows<'w, 's> = Query<
+    'w,
+    's,
+    (Entity, &'static mut Position, Option<&'static mut Captured>),
+    With<ParticleRng>,
+>;
+/// The particles' random streams.
+type StreamRows<'w, 's> = Query<'w, 's, (Entity, &'static mut ParticleRng), With<Position>>;
+
+/// Copy positions, capture flags and random streams to the components: two passes over
+/// disjoint components, side by side on two threads from [`PARTICLE_CHUNK`] particles (each
+/// is a plain copy, so the split changes nothing but the time).
 pub fn write_back_brownian(
     ws: Res<BrownianWorkspace>,
-    mut q: Query<(
-        Entity,
-        &mut Position,
-        Option<&mut Captured>,
-        &mut ParticleRng,
-    )>,
+    mut q: PositionRows,
+    mut streams: StreamRows,
 ) {
-    let write =
-        |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>, mut r: Mut<ParticleRng>| {
+    let ws = &*ws;
+    let positions = |q: &mut PositionRows| {
+        let write = |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>| {
             p.0 = ws.positions[k];
             if let Some(mut c) = c {
                 c.0 = ws.captured[k];
             }
-            r.0.clone_from(&ws.rngs[k]);
         };
-    // a linear pass while the query follows the workspace order, lookups for the rest
-    let k = in_workspace_order(
-        &ws.entities,
-        q.iter_mut().map(|(e, p, c, r)| (e, (p, c, r))),
-        |k, (p, c, r)| write(k, p, c, r),
-    );
-    for (k, e) in ws.entities.iter().enumerate().skip(k) {
-        if let Ok((_, p, c, r)) = q.get_mut(*e) {
-            write(k, p, c, r);
+        // a linear pass while the query follows the workspace order, lookups for the rest
+        let k = in_workspace_order(
+            &ws.entities,
+            q.iter_mut().map(|(e, p, c)| (e, (p, c))),
+            |k, (p, c)| write(k, p, c),
+        );
+        for (k, e) in ws.entities.iter().enumerate().skip(k) {
+            if let Ok((_, p, c)) = q.get_mut(*e) {
+                write(k, p, c);
+            }
         }
+    };
+    let rngs = |q: &mut StreamRows| {
+        let write = |k: usize, mut r: Mut<ParticleRng>| r.0.clone_from(&ws.rngs[k]);
+        let k = in_workspace_order(&ws.entities, q.iter_mut(), write);
+        for (k, e) in ws.entities.iter().enumerate().skip(k) {
+            if let Ok((_, r)) = q.get_mut(*e) {
+                write(k, r);
+            }
+        }
+    };
+    if ws.entities.len() >= 2 * PARTICLE_CHUNK {
+        rayon::join(|| positions(&mut q), || rngs(&mut streams));
+    } else {
+        positions(&mut q);
+        rngs(&mut streams);
     }
 }
 
