@@ -276,6 +276,8 @@ pub fn resume(
         seed: Some(meta.seed),
         resume_from: Some(frame),
         plugins: plugins.to_vec(),
+        // the caller sees the summary and progress only
+        forces_unread: true,
         ..Default::default()
     };
     // the frame fits the pipeline and the schedule has the recorded systems: checked on a

@@ -105,6 +105,13 @@ impl SimulationBuilder<'_> {
         self
     }
 
+    /// Promise that nothing reads the force components during the run (see
+    /// [`RunOptions::forces_unread`]).
+    pub fn forces_unread(mut self, yes: bool) -> Self {
+        self.options.forces_unread = yes;
+        self
+    }
+
     /// Spawn the scene, build the schedule, open the recording.
     ///
     /// # Errors
@@ -161,8 +168,8 @@ impl Simulation {
         for p in &options.plugins {
             app.add_boxed_plugin(p.clone());
         }
-        if options.plugins.is_empty() && options.pipeline.is_none() {
-            // only the pipeline's own systems run: nothing reads the force components
+        if options.forces_unread && options.plugins.is_empty() && options.pipeline.is_none() {
+            // only the pipeline's own systems run and the caller reads no force component
             app.world.insert_resource(ForceComponents::WorkspaceOnly);
         }
         app.finish().map_err(|e| SimError::Schedule(e.0))?;

@@ -213,6 +213,8 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         executor: executor.choice(),
         plugins: ext.plugins.clone(),
         stop: Some(stop),
+        // the CLI reads the summary and the clock only
+        forces_unread: true,
         ..Default::default()
     };
     let progress = StderrProgress::new(quiet, "steps");

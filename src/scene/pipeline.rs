@@ -178,6 +178,14 @@ pub struct RunOptions {
     /// Stop the run early when this flag is set (polled between steps; `magsep run` sets it on
     /// SIGINT/SIGTERM).
     pub stop: Option<StopFlag>,
+    /// The caller reads no force component (`NetForce`, `DipoleForce`, `FieldForce`, ...)
+    /// during the run (neither in `on_step` nor in systems added after the build), so a
+    /// pipeline that keeps its forces in a dense workspace (the brownian one) may skip
+    /// writing them; the trajectory is bitwise the same. Honoured only when no plugin besides
+    /// the pipeline's own runs ([`Self::plugins`] empty, no [`Self::pipeline`]). Default
+    /// false (the components are written); `magsep run`, `replay --resume`, sweeps and the
+    /// benches set it.
+    pub forces_unread: bool,
 }
 
 /// A request to end a run early, shared between threads (its clones are one flag).

@@ -199,7 +199,8 @@ struct Window {
 fn window(scene: &Scene, steps: u64, record: Option<&PathBuf>) -> Result<Window, BenchError> {
     // the window opens with building the simulation, which opens the recording
     let t0 = Instant::now();
-    let mut b = Simulation::builder(scene);
+    // as `magsep run` does
+    let mut b = Simulation::builder(scene).forces_unread(true);
     if let Some(path) = record {
         b = b.record(path.clone());
     }

@@ -222,6 +222,7 @@ pub fn run_scene_text(text: &str, seed: Option<u64>) -> Result<Value, BenchError
         .unwrap_or(1);
     let options = RunOptions {
         seed,
+        forces_unread: true,
         ..RunOptions::default()
     };
     crate::pipelines::brownian::run_ensemble(&scene, runs, &options, &|_| {})

@@ -68,9 +68,10 @@ pub struct ContributionPasses;
 /// honours [`ForceComponents::WorkspaceOnly`] while its own contributions are the only ones
 /// registered: it then skips writing them to the components and the contribution passes,
 /// which only readers outside the pipeline would see. `magsep`'s scene driver asks for it when
-/// the run has no plugin besides the pipeline's own (the recorder reads positions, never
-/// forces); an app whose systems read the forces keeps the default, and inserting
-/// `EveryStep` at any time brings the components back from the next step on.
+/// the caller promises that nothing reads them (`RunOptions::forces_unread`: `magsep run`,
+/// sweeps, benches) and the run has no plugin besides the pipeline's own (the recorder reads
+/// positions, never forces); any other app keeps the default, and inserting `EveryStep` at any
+/// time brings the components back from the next step on.
 #[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ForceComponents {
     /// Written every step.

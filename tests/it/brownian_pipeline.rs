@@ -229,8 +229,12 @@ fn forces_in_the_workspace_only_give_the_trajectory_of_forces_in_components() {
     let s = scene(&magsep::studies::bench_brownian::lammps_mirror_scene(9, 5).unwrap());
     let run = |threads: usize, every_step: bool| {
         on_threads(threads, || {
+            // the library's default keeps the components
+            let kept = Simulation::from_scene(&s, RunOptions::default()).unwrap();
+            assert_eq!(kept.app.world.get_resource::<ForceComponents>(), None);
             let options = RunOptions {
                 single_threaded: true,
+                forces_unread: true,
                 ..Default::default()
             };
             let mut sim = Simulation::from_scene(&s, options).unwrap();

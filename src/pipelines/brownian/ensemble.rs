@@ -87,6 +87,7 @@ pub fn run_ensemble(
             },
             plugins: options.plugins.clone(),
             stop: Some(stop.clone()),
+            forces_unread: options.forces_unread,
         };
         let failed = |e: SimError| {
             stop.request_stop(format!("replicate {k} failed"));

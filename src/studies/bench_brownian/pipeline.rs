@@ -95,6 +95,7 @@ pub fn pipeline_rate(
     pool.install(|| {
         let options = RunOptions {
             single_threaded: true,
+            forces_unread: true,
             ..RunOptions::default()
         };
         let mut sim = Simulation::from_scene(scene, options)

@@ -334,6 +334,7 @@ impl Runner<'_> {
                 record: self.record.then(|| tmp.join("recording.mcap")),
                 single_threaded: true,
                 plugins: self.plugins.clone(),
+                forces_unread: true,
                 ..Default::default()
             };
             match run_scene(&scene, &options, &NoProgress) {
