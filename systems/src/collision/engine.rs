@@ -40,10 +40,10 @@
 //!
 //! **Choices where the thesis is silent.**
 //! * Approaches slower than `approach_tolerance · (r_i + r_j)/h` (walls: `· 2 r_i/h`) are ignored:
-//!   they cannot open an overlap larger than `approach_tolerance` times the diameter within the
-//!   step, and the projection removes it. At the resting contacts of step 2, approaches up to
-//!   twice the solve's remaining residual are ignored too (the event loop would only continue the
-//!   same Gauss–Seidel iteration, one binary collision at a time).
+//!   they open less than `approach_tolerance` d of overlap (the projection removes it). At the
+//!   resting contacts of step 2, approaches up to `max(resting_floor, 2 × residual)` are left to
+//!   the resting solve: below twice its residual the event loop would only go on with its Gauss–
+//!   Seidel iteration; below [`EngineConfig::resting_floor`] (`|g| h`) they are as slow as rest.
 //! * Dense clusters: after `defer_slow_after` events of a particle in one step, its approaches
 //!   slower than `rest_speed` are deferred (overlap `< rest_speed · h`, removed by the projection,
 //!   the next step's resting solve settles the velocities). Hard cap: a particle that took part
@@ -369,7 +369,7 @@ impl Sim<'_, '_> {
             self.eng.radius[i],
         );
         let rest = self.eng.resting_partners(i);
-        let rest_limit = 2.0 * self.resting_residual;
+        let rest_limit = (2.0 * self.resting_residual).max(self.cfg.resting_floor);
         let defer = self.cfg.defer_slow_after;
         let busy_i = self.eng.count[i] >= defer;
         let slow = self.model.rest_speed;
