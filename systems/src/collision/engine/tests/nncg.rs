@@ -7,8 +7,18 @@ use crate::collision::engine::resting_fast::blocked;
 /// A forming bed of 1000 spheres of 1 mm in 1 ms steps (as in the pipeline's settling bed),
 /// `steps` steps with `cfg`; returns the per-step stats and the final state.
 fn forming_bed(cfg: EngineConfig, steps: usize) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
+    forming_bed_of(1000, 10, cfg, steps)
+}
+
+/// [`forming_bed`] of `n` spheres on a `cells × cells` floor.
+fn forming_bed_of(
+    n: usize,
+    cells: usize,
+    cfg: EngineConfig,
+    steps: usize,
+) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
     let (g, h) = (9.81, 1e-3);
-    let (mut s, domain) = bed(1000, 10, 0.5e-3, 7);
+    let (mut s, domain) = bed(n, cells, 0.5e-3, 7);
     let model = CollisionModel {
         tangential_restitution: 0.0,
         ..CollisionModel::dry(0.5, 0.3, 5.0 * g * h)
@@ -116,6 +126,23 @@ fn nncg_steps_do_not_depend_on_the_thread_count() {
     let (a, sa, ea) = run(1);
     let (b, sb, _) = run(2);
     assert!(ea.fast.blocked.grouped.len() >= blocked::SPLIT_MIN_CONTACTS);
+    assert_eq!(a, b);
+    assert_eq!(sa, sb);
+}
+
+/// 2500 spheres: the candidate lists and the predictions run on parallel chunks too.
+#[test]
+fn large_bed_steps_do_not_depend_on_the_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| forming_bed_of(2500, 12, floored(), 40))
+    };
+    let (a, sa, _) = run(1);
+    let (b, sb, _) = run(2);
+    assert!(a.iter().map(|s| s.events).sum::<usize>() > 0);
     assert_eq!(a, b);
     assert_eq!(sa, sb);
 }
