@@ -17,13 +17,22 @@ fn forming_bed_of(
     cfg: EngineConfig,
     steps: usize,
 ) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
+    forming_bed_with(n, cells, CollisionEngine::new(cfg), steps)
+}
+
+/// [`forming_bed_of`] with a given engine.
+fn forming_bed_with(
+    n: usize,
+    cells: usize,
+    mut engine: CollisionEngine,
+    steps: usize,
+) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
     let (g, h) = (9.81, 1e-3);
     let (mut s, domain) = bed(n, cells, 0.5e-3, 7);
     let model = CollisionModel {
         tangential_restitution: 0.0,
         ..CollisionModel::dry(0.5, 0.3, 5.0 * g * h)
     };
-    let mut engine = CollisionEngine::new(cfg);
     let mut out = Vec::with_capacity(steps);
     for _ in 0..steps {
         for v in &mut s.v {
@@ -143,6 +152,25 @@ fn large_bed_steps_do_not_depend_on_the_thread_count() {
     let (a, sa, _) = run(1);
     let (b, sb, _) = run(2);
     assert!(a.iter().map(|s| s.events).sum::<usize>() > 0);
+    assert_eq!(a, b);
+    assert_eq!(sa, sb);
+}
+
+/// The blocked projection's skip of pairs provably apart (by their travel) against the stamps
+/// alone: bitwise the same steps.
+#[test]
+fn projection_travel_skip_is_bitwise_the_stamps_alone() {
+    let run = |plain: bool| {
+        let mut engine = CollisionEngine::new(floored());
+        engine.proj.plain = plain;
+        forming_bed_with(1000, 10, engine, 150)
+    };
+    let (a, sa, _) = run(true);
+    let (b, sb, _) = run(false);
+    assert!(
+        a.iter()
+            .any(|s| s.projection_sweeps > 3 && s.max_overlap_before_projection > 0.0)
+    );
     assert_eq!(a, b);
     assert_eq!(sa, sb);
 }
