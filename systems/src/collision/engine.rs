@@ -43,7 +43,7 @@
 //!   they open less than `approach_tolerance` d of overlap (the projection removes it). At the
 //!   resting contacts of step 2, approaches up to `max(resting_floor, 2 × residual)` are left to
 //!   the resting solve: below twice its residual the event loop would only go on with its Gauss–
-//!   Seidel iteration; below [`EngineConfig::resting_floor`] (`|g| h`) they are as slow as rest.
+//!   Seidel iteration; below [`EngineConfig::resting_floor`] (`|g| h`, spheres) they count as rest.
 //! * Dense clusters: after `defer_slow_after` events of a particle in one step, its approaches
 //!   slower than `rest_speed` are deferred (overlap `< rest_speed · h`, removed by the projection,
 //!   the next step's resting solve settles the velocities). Hard cap: a particle that took part

@@ -60,7 +60,9 @@ impl Sim<'_, '_> {
             self.eng.radius[i],
         );
         let rest = self.eng.resting_partners(i);
-        let rest_limit = (2.0 * self.resting_residual).max(self.cfg.resting_floor);
+        // the floor applies to spheres; a spheroid's contacts keep the residual rule alone
+        let rest_limit_shape = 2.0 * self.resting_residual;
+        let rest_limit = rest_limit_shape.max(self.cfg.resting_floor);
         let defer = self.cfg.defer_slow_after;
         let busy_i = self.eng.count[i] >= defer;
         let slow = self.model.rest_speed;
@@ -99,7 +101,7 @@ impl Sim<'_, '_> {
             if !(self.is_round(i) && self.is_round(j)) {
                 let mut min_approach = tol * s;
                 if resting {
-                    min_approach = min_approach.max(rest_limit);
+                    min_approach = min_approach.max(rest_limit_shape);
                 }
                 if busy {
                     min_approach = min_approach.max(slow);
@@ -128,7 +130,7 @@ impl Sim<'_, '_> {
             if !self.is_round(i) {
                 let mut min_approach = tol * 2.0 * ri;
                 if resting {
-                    min_approach = min_approach.max(rest_limit);
+                    min_approach = min_approach.max(rest_limit_shape);
                 }
                 if busy_i {
                     min_approach = min_approach.max(slow);

@@ -51,8 +51,8 @@ pub struct EngineConfig {
     /// `max(resting_floor, 2 × residual)`, the residual being the largest approach the resting
     /// solve left. Set it to the speed the step's largest body acceleration adds in one step
     /// (`|g| h` under gravity: the `particle_fluid` pipeline does): an approach that slow is
-    /// indistinguishable from resting within the step. Default: 0 (the residual rule alone).
-    /// Range: ≥ 0.
+    /// indistinguishable from resting within the step. Spheres only: pairs with a spheroid keep
+    /// the residual rule alone. Default: 0 (the residual rule alone). Range: ≥ 0.
     #[serde(default)]
     pub resting_floor: f64,
 }
