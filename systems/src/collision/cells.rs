@@ -11,9 +11,12 @@
 //! degenerates gracefully into a few cells (exhaustive search for tiny `N`).
 //!
 //! The lists are symmetric (`j ∈ C(i) ⇔ i ∈ C(j)`), sorted by index, and independent of any
-//! hash order: the result is a pure function of the input.
+//! hash order: the result is a pure function of the input. From 2048 particles the lists are
+//! built on fixed chunks of 1024 particles side by side and joined in particle order (the same
+//! lists on any number of threads).
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::domain::CollisionDomain;
 
@@ -174,33 +177,86 @@ impl Candidates {
         self.offsets.clear();
         self.offsets.push(0);
         self.partners.clear();
-        for i in 0..n {
-            let c = self.cell_of[i];
-            let home = [c % nx, (c / nx) % ny, c / (nx * ny)];
-            let [(bx, lx), (by, ly), (bz, lz)] =
-                std::array::from_fn(|k| axes[k].neighbours(home[k]));
-            let start = self.partners.len();
-            for &cz in &bz[..lz] {
-                for &cy in &by[..ly] {
-                    for &cx in &bx[..lx] {
-                        let cell = cell_id([cx, cy, cz]);
-                        for &j in &self.cell_items[self.cell_start[cell]..self.cell_start[cell + 1]]
-                        {
-                            let j = j as usize;
-                            if j == i {
-                                continue;
-                            }
-                            let d = domain.minimum_image(x[j] - x[i]).length();
-                            if d <= radii[i] + radii[j] + reach {
-                                self.partners.push(j as u32);
-                            }
+        let grid = Grid {
+            axes,
+            cell_of: &self.cell_of,
+            cell_start: &self.cell_start,
+            cell_items: &self.cell_items,
+        };
+        if n < 2 * CHUNK {
+            for i in 0..n {
+                grid.list(i, x, radii, domain, reach, &mut self.partners);
+                self.offsets.push(self.partners.len());
+            }
+            return;
+        }
+        // fixed chunks side by side, joined in particle order: the same lists on any thread count
+        let chunks: Vec<(Vec<u32>, Vec<usize>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (mut partners, mut ends) = (Vec::new(), Vec::with_capacity(CHUNK));
+                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    grid.list(i, x, radii, domain, reach, &mut partners);
+                    ends.push(partners.len());
+                }
+                (partners, ends)
+            })
+            .collect();
+        for (partners, ends) in chunks {
+            let base = self.partners.len();
+            self.offsets.extend(ends.iter().map(|e| base + e));
+            self.partners.extend_from_slice(&partners);
+        }
+    }
+}
+
+/// Particles per chunk of the parallel list build; fewer than two chunks build serially.
+const CHUNK: usize = 1024;
+
+/// The filled cell grid of one build.
+struct Grid<'a> {
+    axes: [Axis; 3],
+    cell_of: &'a [usize],
+    cell_start: &'a [usize],
+    cell_items: &'a [u32],
+}
+
+impl Grid<'_> {
+    /// Appends particle `i`'s sorted candidates to `out`.
+    fn list(
+        &self,
+        i: usize,
+        x: &[DVec3],
+        radii: &[f64],
+        domain: &CollisionDomain,
+        reach: f64,
+        out: &mut Vec<u32>,
+    ) {
+        let axes = &self.axes;
+        let (nx, ny) = (axes[0].cells, axes[1].cells);
+        let cell_id = |c: [usize; 3]| c[0] + nx * (c[1] + ny * c[2]);
+        let c = self.cell_of[i];
+        let home = [c % nx, (c / nx) % ny, c / (nx * ny)];
+        let [(bx, lx), (by, ly), (bz, lz)] = std::array::from_fn(|k| axes[k].neighbours(home[k]));
+        let start = out.len();
+        for &cz in &bz[..lz] {
+            for &cy in &by[..ly] {
+                for &cx in &bx[..lx] {
+                    let cell = cell_id([cx, cy, cz]);
+                    for &j in &self.cell_items[self.cell_start[cell]..self.cell_start[cell + 1]] {
+                        let j = j as usize;
+                        if j == i {
+                            continue;
+                        }
+                        let d = domain.minimum_image(x[j] - x[i]).length();
+                        if d <= radii[i] + radii[j] + reach {
+                            out.push(j as u32);
                         }
                     }
                 }
             }
-            self.partners[start..].sort_unstable();
-            self.offsets.push(self.partners.len());
         }
+        out[start..].sort_unstable();
     }
 }
 
@@ -214,7 +270,7 @@ mod tests {
     #[test]
     fn matches_brute_force_with_periodic_axes_and_small_boxes() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
-        for (len, n) in [(1.0, 400), (0.25, 50), (0.1, 20), (3.0, 300)] {
+        for (len, n) in [(1.0, 400), (0.25, 50), (0.1, 20), (3.0, 300), (1.0, 2500)] {
             let domain = CollisionDomain::unbounded()
                 .with_periodic(0, -0.5, len)
                 .with_periodic(2, 0.0, len);

@@ -40,10 +40,10 @@
 //!
 //! **Choices where the thesis is silent.**
 //! * Approaches slower than `approach_tolerance · (r_i + r_j)/h` (walls: `· 2 r_i/h`) are ignored:
-//!   they cannot open an overlap larger than `approach_tolerance` times the diameter within the
-//!   step, and the projection removes it. At the resting contacts of step 2, approaches up to
-//!   twice the solve's remaining residual are ignored too (the event loop would only continue the
-//!   same Gauss–Seidel iteration, one binary collision at a time).
+//!   they open less than `approach_tolerance` d of overlap (the projection removes it). At the
+//!   resting contacts of step 2, approaches up to `max(resting_floor, 2 × residual)` are left to
+//!   the resting solve: below twice its residual the event loop would only go on with its Gauss–
+//!   Seidel iteration; below [`EngineConfig::resting_floor`] (`|g| h`, spheres) they count as rest.
 //! * Dense clusters: after `defer_slow_after` events of a particle in one step, its approaches
 //!   slower than `rest_speed` are deferred (overlap `< rest_speed · h`, removed by the projection,
 //!   the next step's resting solve settles the velocities). Hard cap: a particle that took part
@@ -90,6 +90,7 @@ use super::restitution::{CollisionModel, Counterpart};
 use super::toi::{sphere_plane_toi, sphere_sphere_toi};
 use event::Event;
 mod event;
+mod predict;
 mod projection;
 mod resting;
 mod resting_fast;
@@ -152,6 +153,8 @@ pub struct CollisionEngine {
     proj: projection::blocked::Scratch,
     /// Use the plain reference kernels instead of the fast ones (tests compare the two).
     reference: bool,
+    /// Scratch of the parallel predictions.
+    predicted: Vec<Event>,
 }
 
 impl CollisionEngine {
@@ -291,9 +294,7 @@ impl Sim<'_, '_> {
             self.speed_bound = fastest;
             self.build_candidates();
         }
-        for i in 0..n {
-            self.predict(i, 0.0);
-        }
+        self.predict_all(0.0);
         while let Some(Reverse(ev)) = self.eng.heap.pop() {
             self.handle(ev);
         }
@@ -333,9 +334,7 @@ impl Sim<'_, '_> {
         for i in 0..self.n() {
             self.eng.version[i] = self.eng.version[i].wrapping_add(1);
         }
-        for i in 0..self.n() {
-            self.predict(i, now);
-        }
+        self.predict_all(now);
     }
 
     #[inline]
@@ -353,121 +352,6 @@ impl Sim<'_, '_> {
     #[inline]
     fn capped(&self, i: usize) -> bool {
         self.eng.count[i] >= self.cfg.max_events_per_particle
-    }
-
-    /// Pushes particle `i`'s earliest event in `[now, h]`, if any.
-    fn predict(&mut self, i: usize, now: f64) {
-        if self.capped(i) {
-            return;
-        }
-        let n = self.n();
-        let horizon = self.h - now;
-        let tol = self.cfg.approach_tolerance / self.h;
-        let (xi, vi, ri) = (
-            self.position_at(i, now),
-            self.p.velocities[i],
-            self.eng.radius[i],
-        );
-        let rest = self.eng.resting_partners(i);
-        let rest_limit = 2.0 * self.resting_residual;
-        let defer = self.cfg.defer_slow_after;
-        let busy_i = self.eng.count[i] >= defer;
-        let slow = self.model.rest_speed;
-        let mut r = 0;
-        let mut is_resting = |code: usize| {
-            while r < rest.len() && (rest[r] as usize) < code {
-                r += 1;
-            }
-            r < rest.len() && rest[r] as usize == code
-        };
-        let mut best: Option<(f64, u32, u32)> = None;
-        let mut offer = |t: f64, lo: usize, hi: usize| {
-            let cand = (now + t, lo as u32, hi as u32);
-            let better = match best {
-                None => true,
-                Some(b) => cand
-                    .0
-                    .total_cmp(&b.0)
-                    .then((cand.1, cand.2).cmp(&(b.1, b.2)))
-                    .is_lt(),
-            };
-            if better {
-                best = Some(cand);
-            }
-        };
-        for &j in self.eng.candidates.of(i) {
-            let j = j as usize;
-            if self.capped(j) {
-                continue;
-            }
-            let dx = self.domain.minimum_image(self.position_at(j, now) - xi);
-            let dv = self.p.velocities[j] - vi;
-            let s = ri + self.eng.radius[j];
-            let resting = is_resting(j);
-            let busy = busy_i || self.eng.count[j] >= defer;
-            if !(self.is_round(i) && self.is_round(j)) {
-                let mut min_approach = tol * s;
-                if resting {
-                    min_approach = min_approach.max(rest_limit);
-                }
-                if busy {
-                    min_approach = min_approach.max(slow);
-                }
-                if let Some(hit) =
-                    self.spheroid_pair_impact(i, j, xi, dx, now, horizon, min_approach)
-                {
-                    offer(hit.time, i.min(j), i.max(j));
-                }
-                continue;
-            }
-            if let Some(t) = sphere_sphere_toi(dx, dv, s, horizon) {
-                let d = dx + dv * t;
-                let approach = -dv.dot(d) / d.length();
-                if approach > tol * s
-                    && !(resting && approach <= rest_limit)
-                    && !(busy && approach < slow)
-                {
-                    offer(t, i.min(j), i.max(j));
-                }
-            }
-        }
-        for (w, plane) in self.domain.planes.iter().enumerate() {
-            let approach = -vi.dot(plane.normal);
-            let resting = is_resting(n + w);
-            if !self.is_round(i) {
-                let mut min_approach = tol * 2.0 * ri;
-                if resting {
-                    min_approach = min_approach.max(rest_limit);
-                }
-                if busy_i {
-                    min_approach = min_approach.max(slow);
-                }
-                if let Some(hit) =
-                    self.spheroid_wall_impact(i, xi, now, plane, horizon, min_approach)
-                {
-                    offer(hit.time, i, n + w);
-                }
-                continue;
-            }
-            if let Some(t) = sphere_plane_toi(xi, vi, ri, plane, horizon)
-                && approach > tol * 2.0 * ri
-                && !(resting && approach <= rest_limit)
-                && !(busy_i && approach < slow)
-            {
-                offer(t, i, n + w);
-            }
-        }
-        if let Some((time, lo, hi)) = best {
-            let v = &self.eng.version;
-            self.eng.heap.push(Reverse(Event {
-                time: time.min(self.h),
-                lo,
-                hi,
-                owner: i as u32,
-                ver_lo: v[lo as usize],
-                ver_hi: v.get(hi as usize).copied().unwrap_or(0),
-            }));
-        }
     }
 
     fn body(&self, i: usize) -> RigidBody {

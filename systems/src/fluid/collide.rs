@@ -14,6 +14,10 @@
 //! with `1/I_z = 0` for spheroids: collisions do not change the spin about the symmetry axis
 //! (`I_z → ∞`, as the thesis suppresses that spin). Without spheroids the sphere-only path
 //! (isotropic inverse inertia `1/I_x`, no shapes) runs unchanged.
+//!
+//! The engine's [`EngineConfig::resting_floor`](crate::collision::engine::EngineConfig) is set
+//! to `|g| Δt` when gravity acts (0 otherwise): approaches at resting contacts slower than what
+//! gravity adds in one step are left to the resting solve instead of the event loop.
 
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
@@ -179,6 +183,18 @@ pub fn resolve_collisions(
         densities: &ws.densities,
         spheroids,
     };
+    // approaches at resting contacts slower than what gravity adds in a step are left to the
+    // resting solve (`EngineConfig::resting_floor`)
+    let floor = if cfg.terms.gravity {
+        cfg.gravity.abs() * cfg.dt
+    } else {
+        0.0
+    };
+    if ws.engine.config().resting_floor != floor {
+        let mut c = *ws.engine.config();
+        c.resting_floor = floor;
+        ws.engine.set_config(c);
+    }
     let report = match ws.engine.step(arrays, &domain.0, &ws.model, cfg.dt) {
         Ok(r) => r,
         Err(e) => {

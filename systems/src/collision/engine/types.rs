@@ -46,6 +46,15 @@ pub struct EngineConfig {
     /// `resting_sweeps`. Non-spherical particles always use the plain sweeps. Default: 35.
     /// Range: ≥ 0.
     pub nncg_sweeps: u32,
+    /// Approach speed \[m/s\] up to which the event loop leaves an approach at a resting contact
+    /// to the resting solve (and the projection): it ignores approaches there up to
+    /// `max(resting_floor, 2 × residual)`, the residual being the largest approach the resting
+    /// solve left. Set it to the speed the step's largest body acceleration adds in one step
+    /// (`|g| h` under gravity: the `particle_fluid` pipeline does): an approach that slow is
+    /// indistinguishable from resting within the step. Spheres only: pairs with a spheroid keep
+    /// the residual rule alone. Default: 0 (the residual rule alone). Range: ≥ 0.
+    #[serde(default)]
+    pub resting_floor: f64,
 }
 
 impl Default for EngineConfig {
@@ -61,6 +70,7 @@ impl Default for EngineConfig {
             resting_tolerance: 1e-5,
             warm_start: true,
             nncg_sweeps: 35,
+            resting_floor: 0.0,
         }
     }
 }

@@ -12,6 +12,14 @@
 //! the serial sweeps ([`super`]), with stamps `phase << 32 | count`: the phases run one after
 //! the other, and within a phase each block counts for itself and only compares its own
 //! particles' stamps.
+//!
+//! Pairs provably apart are skipped too: each particle sums the lengths of its moves in the step
+//! (`travel`), and a pair found apart by a gap `g` keeps `slack = g + travel_i + travel_j` (less
+//! 1e-9 of the summed radii for rounding); while `travel_i + travel_j < slack` the two moved less
+//! than the gap in all, so the pair is still apart (the minimum-image distance changes no faster
+//! than the positions) and its evaluation, which would only find it apart, is skipped. Evaluating
+//! an apart pair changes no position and no overlap, so the result is bitwise that of the
+//! stamps alone (`Scratch::plain`, a test compares the two).
 
 use glam::DVec3;
 
@@ -39,6 +47,12 @@ pub(in crate::collision::engine) struct Scratch {
     apart: [Vec<u64>; 3],
     /// Per local particle and wall, the stamp of the last evaluation that found them apart.
     wall_apart: Vec<u64>,
+    /// Per local particle, the summed lengths of its moves this step [m].
+    travel: Vec<f64>,
+    /// Per block and pair, its gap plus its particles' travel when last found apart [m].
+    slack: [Vec<f64>; 3],
+    /// Skip pairs by the stamps alone (the reference of the slack skip; tests).
+    pub(in crate::collision::engine) plain: bool,
 }
 
 /// The shared read-only inputs of a pass.
@@ -49,17 +63,21 @@ struct Ctx<'a> {
     fix: bool,
     backward: bool,
     phase: u64,
+    plain: bool,
 }
 
 /// One pass over `pairs` of particles `x` (local indices); returns the largest relative overlap.
+#[allow(clippy::too_many_arguments)]
 fn pairs_pass(
     ctx: Ctx<'_>,
     pairs: &[[u32; 2]],
     apart: &mut [u64],
+    slack: &mut [f64],
     x: &mut [DVec3],
     r: &[f64],
     w: &[f64],
     moved: &mut [u64],
+    travel: &mut [f64],
 ) -> f64 {
     let mut stamp = ctx.phase << 32;
     let mut worst = 0.0f64;
@@ -71,6 +89,9 @@ fn pairs_pass(
         if apart[k] > moved[i] && apart[k] > moved[j] {
             continue;
         }
+        if !ctx.plain && travel[i] + travel[j] < slack[k] {
+            continue; // moved less than the gap since found apart
+        }
         stamp += 1;
         let dx = ctx.domain.minimum_image(x[j] - x[i]);
         let dist = dx.length();
@@ -78,6 +99,8 @@ fn pairs_pass(
         let overlap = s - dist;
         if overlap <= 0.0 || overlap.is_nan() {
             apart[k] = stamp;
+            // NaN: no skip (the comparison fails)
+            slack[k] = travel[i] + travel[j] - overlap - 1e-9 * s;
             continue;
         }
         worst = worst.max(overlap / s);
@@ -85,11 +108,14 @@ fn pairs_pass(
         if ctx.fix && wsum > 0.0 {
             let before = (x[i], x[j]);
             let normal = if dist > 0.0 { dx / dist } else { DVec3::Z };
-            x[i] -= normal * (overlap * w[i] / wsum);
-            x[j] += normal * (overlap * w[j] / wsum);
+            let (si, sj) = (overlap * w[i] / wsum, overlap * w[j] / wsum);
+            x[i] -= normal * si;
+            x[j] += normal * sj;
             if (x[i], x[j]) != before {
                 moved[i] = stamp;
                 moved[j] = stamp;
+                travel[i] += si;
+                travel[j] += sj;
             }
         }
     }
@@ -104,6 +130,7 @@ fn walls_pass(
     w: &[f64],
     moved: &mut [u64],
     wall_apart: &mut [u64],
+    travel: &mut [f64],
 ) -> f64 {
     let mut stamp = ctx.phase << 32;
     let mut worst = 0.0f64;
@@ -128,6 +155,7 @@ fn walls_pass(
                 x[i] += plane.normal * overlap;
                 if x[i] != before {
                     moved[i] = stamp;
+                    travel[i] += overlap;
                 }
             }
         }
@@ -152,6 +180,7 @@ impl Scratch {
             fix,
             backward,
             phase: 0,
+            plain: self.plain,
         };
         let mut worst = 0.0f64;
         let order: [u8; 3] = if backward { [2, 1, 0] } else { [0, 1, 2] };
@@ -162,13 +191,15 @@ impl Scratch {
             let (r0, r1) = self.r.split_at(n0);
             let (w0, w1) = self.w.split_at(n0);
             let (m0, m1) = self.moved.split_at_mut(n0);
+            let (t0, t1) = self.travel.split_at_mut(n0);
             let o = match stage {
                 0 => {
                     let [p0, p1, _] = &self.pairs;
                     let [a0, a1, _] = &mut self.apart;
+                    let [k0, k1, _] = &mut self.slack;
                     let (o0, o1) = rayon::join(
-                        || pairs_pass(ctx, p0, a0, x0, r0, w0, m0),
-                        || pairs_pass(ctx, p1, a1, x1, r1, w1, m1),
+                        || pairs_pass(ctx, p0, a0, k0, x0, r0, w0, m0, t0),
+                        || pairs_pass(ctx, p1, a1, k1, x1, r1, w1, m1, t1),
                     );
                     o0.max(o1)
                 }
@@ -176,16 +207,18 @@ impl Scratch {
                     ctx,
                     &self.pairs[2],
                     &mut self.apart[2],
+                    &mut self.slack[2],
                     &mut self.x,
                     &self.r,
                     &self.w,
                     &mut self.moved,
+                    &mut self.travel,
                 ),
                 _ => {
                     let (s0, s1) = self.wall_apart.split_at_mut(n0 * planes.len());
                     let (o0, o1) = rayon::join(
-                        || walls_pass(ctx, x0, r0, w0, m0, s0),
-                        || walls_pass(ctx, x1, r1, w1, m1, s1),
+                        || walls_pass(ctx, x0, r0, w0, m0, s0, t0),
+                        || walls_pass(ctx, x1, r1, w1, m1, s1, t1),
                     );
                     o0.max(o1)
                 }
@@ -239,9 +272,13 @@ impl Sim<'_, '_> {
         for b in 0..3 {
             s.apart[b].clear();
             s.apart[b].resize(s.pairs[b].len(), 0);
+            s.slack[b].clear();
+            s.slack[b].resize(s.pairs[b].len(), 0.0);
         }
         s.moved.clear();
         s.moved.resize(n, 0);
+        s.travel.clear();
+        s.travel.resize(n, 0.0);
         s.wall_apart.clear();
         s.wall_apart.resize(n * self.domain.planes.len(), 0);
         let mut phase = 0;

@@ -7,13 +7,32 @@ use crate::collision::engine::resting_fast::blocked;
 /// A forming bed of 1000 spheres of 1 mm in 1 ms steps (as in the pipeline's settling bed),
 /// `steps` steps with `cfg`; returns the per-step stats and the final state.
 fn forming_bed(cfg: EngineConfig, steps: usize) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
+    forming_bed_of(1000, 10, cfg, steps)
+}
+
+/// [`forming_bed`] of `n` spheres on a `cells × cells` floor.
+fn forming_bed_of(
+    n: usize,
+    cells: usize,
+    cfg: EngineConfig,
+    steps: usize,
+) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
+    forming_bed_with(n, cells, CollisionEngine::new(cfg), steps)
+}
+
+/// [`forming_bed_of`] with a given engine.
+fn forming_bed_with(
+    n: usize,
+    cells: usize,
+    mut engine: CollisionEngine,
+    steps: usize,
+) -> (Vec<CollisionStats>, Spheres, CollisionEngine) {
     let (g, h) = (9.81, 1e-3);
-    let (mut s, domain) = bed(1000, 10, 0.5e-3, 7);
+    let (mut s, domain) = bed(n, cells, 0.5e-3, 7);
     let model = CollisionModel {
         tangential_restitution: 0.0,
         ..CollisionModel::dry(0.5, 0.3, 5.0 * g * h)
     };
-    let mut engine = CollisionEngine::new(cfg);
     let mut out = Vec::with_capacity(steps);
     for _ in 0..steps {
         for v in &mut s.v {
@@ -72,6 +91,38 @@ fn nncg_bed_matches_the_gauss_seidel_reference_bed() {
     assert!(ob.0 <= oa.0 * 1.1 && ob.1 <= oa.1 * 1.5, "{ob:?} vs {oa:?}");
 }
 
+/// NNCG with the resting floor `|g| h` (the pipeline's setting).
+fn floored() -> EngineConfig {
+    EngineConfig {
+        resting_floor: 9.81 * 1e-3,
+        ..EngineConfig::default()
+    }
+}
+
+#[test]
+fn resting_floor_bed_matches_the_reference_with_fewer_events() {
+    let steps = 300;
+    let (a, sa, _) = forming_bed(pgs(), steps);
+    let (b, _, _) = forming_bed(EngineConfig::default(), steps);
+    let (c, sc, _) = forming_bed(floored(), steps);
+    let (ha, hc) = (mean_height(&sa), mean_height(&sc));
+    let res = |s: &CollisionStats| s.resting_residual;
+    let over = |s: &CollisionStats| s.max_overlap_after_projection;
+    let (ra, rc) = (mean_max(&a, res), mean_max(&c, res));
+    let (oa, oc) = (mean_max(&a, over), mean_max(&c, over));
+    let events = |st: &[CollisionStats]| st.iter().map(|s| s.events).sum::<usize>();
+    let (ea, eb, ec) = (events(&a), events(&b), events(&c));
+    println!("events: PGS {ea}, NNCG {eb}, NNCG + floor {ec}; height / d {ha:.5}, {hc:.5}");
+    println!("residual mean, max [m/s]: PGS {ra:?}, floor {rc:?}");
+    println!("overlap after projection mean, max [d]: PGS {oa:?}, floor {oc:?}");
+    // the floor leaves slow approaches at resting contacts to the solve: fewer events
+    assert!(ec < eb, "{ec} vs {eb}");
+    // the same bed, no less converged than the reference (the bounds of the NNCG test)
+    assert!((ha - hc).abs() < 1e-2 * ha, "{ha} vs {hc}");
+    assert!(rc.0 <= ra.0 && rc.1 <= ra.1 * 1.5, "{rc:?} vs {ra:?}");
+    assert!(oc.0 <= oa.0 * 1.1 && oc.1 <= oa.1 * 1.5, "{oc:?} vs {oa:?}");
+}
+
 #[test]
 fn nncg_steps_do_not_depend_on_the_thread_count() {
     let run = |threads: usize| {
@@ -88,6 +139,42 @@ fn nncg_steps_do_not_depend_on_the_thread_count() {
     assert_eq!(sa, sb);
 }
 
+/// 2500 spheres: the candidate lists and the predictions run on parallel chunks too.
+#[test]
+fn large_bed_steps_do_not_depend_on_the_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| forming_bed_of(2500, 12, floored(), 40))
+    };
+    let (a, sa, _) = run(1);
+    let (b, sb, _) = run(2);
+    assert!(a.iter().map(|s| s.events).sum::<usize>() > 0);
+    assert_eq!(a, b);
+    assert_eq!(sa, sb);
+}
+
+/// The blocked projection's skip of pairs provably apart (by their travel) against the stamps
+/// alone: bitwise the same steps.
+#[test]
+fn projection_travel_skip_is_bitwise_the_stamps_alone() {
+    let run = |plain: bool| {
+        let mut engine = CollisionEngine::new(floored());
+        engine.proj.plain = plain;
+        forming_bed_with(1000, 10, engine, 150)
+    };
+    let (a, sa, _) = run(true);
+    let (b, sb, _) = run(false);
+    assert!(
+        a.iter()
+            .any(|s| s.projection_sweeps > 3 && s.max_overlap_before_projection > 0.0)
+    );
+    assert_eq!(a, b);
+    assert_eq!(sa, sb);
+}
+
 /// Per-step convergence of PGS at 50 sweeps against NNCG at several budgets on the forming bed
 /// (`cargo test --release -p magsep-systems --lib nncg_probe -- --ignored --nocapture`).
 #[test]
@@ -98,7 +185,10 @@ fn nncg_probe() {
         .map(|v| v.split(',').filter_map(|x| x.parse().ok()).collect())
         .unwrap_or_else(|| vec![20, 25, 30, 35, 40]);
     let steps = 300;
-    let mut cfgs = vec![("PGS 50".to_string(), pgs())];
+    let mut cfgs = vec![
+        ("PGS 50".to_string(), pgs()),
+        ("NNCG 35, floor g h".to_string(), floored()),
+    ];
     for k in budgets {
         let cfg = EngineConfig {
             nncg_sweeps: k,
