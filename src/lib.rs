@@ -63,8 +63,3 @@ pub use magsep_plugins as plugins;
 pub use magsep_systems as systems;
 pub use serde_json;
 pub use toml;
-
-/// The plugin guide's snippets, compiled and run as doctests.
-#[cfg(doctest)]
-#[doc = include_str!("../docs/writing-a-plugin.md")]
-pub struct PluginGuideDoctests;

@@ -121,7 +121,9 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
     replay_with(path, &Registry::default())
 }
 
-/// Replay a recording with the pipelines of `registry`.
+/// Replay a recording with the pipelines of `registry`: the pipeline's
+/// [`replay`](crate::scene::Pipeline::replay), with `"truncated"` (what was damaged, as read)
+/// added when the file was cut or damaged and the pipeline did not say so.
 ///
 /// # Errors
 /// [`ReplayError`].
@@ -132,7 +134,13 @@ pub fn replay_with(path: &Path, registry: &Registry) -> Result<(Value, Recording
     let pipeline = scene.pipeline.clone().ok_or_else(|| {
         ReplayError::Unsupported("the recorded scene is field-only: nothing to replay".into())
     })?;
-    let summary = pipeline.replay(&rec, &scene, meta.seed)?;
+    let mut summary = pipeline.replay(&rec, &scene, meta.seed)?;
+    // a damaged file says so whatever the pipeline's replay reports
+    if let (Some(t), Some(obj)) = (&rec.truncated, summary.as_object_mut())
+        && !obj.contains_key("truncated")
+    {
+        obj.insert("truncated".into(), Value::String(t.clone()));
+    }
     Ok((summary, rec))
 }
 

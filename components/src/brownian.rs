@@ -140,11 +140,14 @@ pub enum StepControl {
     /// `max_displacement` (both in units of its radius).
     Adaptive {
         /// Local error tolerance in units of the particle radius. Default 1e-2. Range (0, 1].
+        #[serde(default = "default_step_tolerance")]
         tolerance: f64,
         /// Largest move of one accepted sub-step in units of the radius. Default 0.5.
         /// Range (0, 10].
+        #[serde(default = "default_max_displacement")]
         max_displacement: f64,
         /// Deepest bisection (sub-steps of dt / 2^depth). Default 24. Range 1..=40.
+        #[serde(default = "default_max_depth")]
         max_depth: u32,
     },
     /// As `Adaptive`, but only the particles that fail the test, with their interaction
@@ -152,11 +155,14 @@ pub enum StepControl {
     /// sub-steps at interpolated positions (multirate). Free draining with a soft or no core;
     /// with hydrodynamic interactions or hard cores it steps as `Adaptive`.
     Multirate {
-        /// As in `Adaptive`. Range (0, 1].
+        /// As in `Adaptive`. Default 1e-2. Range (0, 1].
+        #[serde(default = "default_step_tolerance")]
         tolerance: f64,
-        /// As in `Adaptive`. Range (0, 10].
+        /// As in `Adaptive`. Default 0.5. Range (0, 10].
+        #[serde(default = "default_max_displacement")]
         max_displacement: f64,
-        /// As in `Adaptive`. Range 1..=40.
+        /// As in `Adaptive`. Default 24. Range 1..=40.
+        #[serde(default = "default_max_depth")]
         max_depth: u32,
     },
 }
@@ -180,12 +186,24 @@ impl StepControl {
     }
 }
 
+fn default_step_tolerance() -> f64 {
+    1e-2
+}
+
+fn default_max_displacement() -> f64 {
+    0.5
+}
+
+fn default_max_depth() -> u32 {
+    24
+}
+
 impl Default for StepControl {
     fn default() -> Self {
         Self::Adaptive {
-            tolerance: 1e-2,
-            max_displacement: 0.5,
-            max_depth: 24,
+            tolerance: default_step_tolerance(),
+            max_displacement: default_max_displacement(),
+            max_depth: default_max_depth(),
         }
     }
 }

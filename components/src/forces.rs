@@ -48,58 +48,93 @@ pub struct NetForce(pub DVec3);
 pub struct NetTorque(pub DVec3);
 
 /// Define a force contribution component: a newtype around a force \[N\] implementing
-/// [`ForceContribution`] (used by the built-in contributions).
+/// [`ForceContribution`] (used by the built-in contributions and by plugins).
+///
+/// The expansion names `bevy_ecs`, `glam` and `serde` only through this crate, so it
+/// compiles in a crate that depends on nothing but `magsep` (or `magsep_components`):
 ///
 /// ```
-/// use glam::DVec3;
 /// use magsep_components::force_contribution;
 /// use magsep_components::forces::ForceContribution;
 /// force_contribution!(
 ///     /// A test force [N].
 ///     TestForce
 /// );
-/// let mut f = TestForce(DVec3::X);
+/// let mut f = TestForce(glam::DVec3::X);
 /// f.clear();
-/// assert_eq!(f.force(), DVec3::ZERO);
+/// assert_eq!(f.force(), glam::DVec3::ZERO);
 /// ```
 #[macro_export]
 macro_rules! force_contribution {
     ($(#[$doc:meta])* $name:ident) => {
-        $(#[$doc])*
-        #[derive(bevy_ecs::prelude::Component, Debug, Default, Clone, Copy, PartialEq,
-            serde::Serialize, serde::Deserialize)]
-        pub struct $name(pub glam::DVec3);
+        $crate::__contribution_type!($(#[$doc])* $name);
 
         impl $crate::forces::ForceContribution for $name {
-            fn force(&self) -> glam::DVec3 {
+            fn force(&self) -> $crate::__private::glam::DVec3 {
                 self.0
             }
             fn clear(&mut self) {
-                self.0 = glam::DVec3::ZERO;
+                self.0 = $crate::__private::glam::DVec3::ZERO;
             }
         }
     };
 }
 
 /// Declare a torque-only contribution component: a newtype over the torque `DVec3` [N m]
-/// that implements [`ForceContribution`] with zero force.
+/// that implements [`ForceContribution`] with zero force (paths as in [`force_contribution!`]).
 #[macro_export]
 macro_rules! torque_contribution {
     ($(#[$doc:meta])* $name:ident) => {
-        $(#[$doc])*
-        #[derive(bevy_ecs::prelude::Component, Debug, Default, Clone, Copy, PartialEq,
-            serde::Serialize, serde::Deserialize)]
-        pub struct $name(pub glam::DVec3);
+        $crate::__contribution_type!($(#[$doc])* $name);
 
         impl $crate::forces::ForceContribution for $name {
-            fn force(&self) -> glam::DVec3 {
-                glam::DVec3::ZERO
+            fn force(&self) -> $crate::__private::glam::DVec3 {
+                $crate::__private::glam::DVec3::ZERO
             }
-            fn torque(&self) -> glam::DVec3 {
+            fn torque(&self) -> $crate::__private::glam::DVec3 {
                 self.0
             }
             fn clear(&mut self) {
-                self.0 = glam::DVec3::ZERO;
+                self.0 = $crate::__private::glam::DVec3::ZERO;
+            }
+        }
+    };
+}
+
+/// The newtype and its `Component`, `Serialize` and `Deserialize` impls, written out (not
+/// derived) so that no path depends on the caller's imports. Serialisation is that of the
+/// inner vector, as `#[derive]` gives a newtype struct in JSON and TOML.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __contribution_type {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Debug, Default, Clone, Copy, PartialEq)]
+        pub struct $name(pub $crate::__private::glam::DVec3);
+
+        impl $crate::__private::bevy_ecs::component::Component for $name {
+            const STORAGE_TYPE: $crate::__private::bevy_ecs::component::StorageType =
+                $crate::__private::bevy_ecs::component::StorageType::Table;
+            type Mutability = $crate::__private::bevy_ecs::component::Mutable;
+        }
+
+        impl $crate::__private::serde::Serialize for $name {
+            fn serialize<S: $crate::__private::serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> ::core::result::Result<S::Ok, S::Error> {
+                serializer.serialize_newtype_struct(::core::stringify!($name), &self.0)
+            }
+        }
+
+        impl<'de> $crate::__private::serde::Deserialize<'de> for $name {
+            fn deserialize<D: $crate::__private::serde::Deserializer<'de>>(
+                deserializer: D,
+            ) -> ::core::result::Result<Self, D::Error> {
+                <$crate::__private::glam::DVec3 as $crate::__private::serde::Deserialize>::deserialize(
+                    deserializer,
+                )
+                .map($name)
             }
         }
     };

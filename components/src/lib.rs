@@ -12,6 +12,15 @@
 
 #![warn(missing_docs)]
 
+/// What the exported macros name, so that their expansions compile in a crate that does not
+/// depend on these crates itself.
+#[doc(hidden)]
+pub mod __private {
+    pub use bevy_ecs;
+    pub use glam;
+    pub use serde;
+}
+
 pub mod brownian;
 pub mod clock;
 pub mod container;

@@ -3,7 +3,9 @@
 //! [`record_now`]. The recorder knows no pipeline: a pipeline (or any plugin) adds what its
 //! frames need beyond particles through [`FrameStatusProviders`] (keys of the frame's
 //! `status_json`), [`ParticleColours`] or [`ColourProvider`], and writes channels of its own
-//! through [`Recorder::writer`].
+//! through [`FrameWriters`]: each runs right after every frame the recorder writes (the
+//! scheduled ones, step 0, the final step, and the last frame of an interrupted or failed run),
+//! so a plugin's channel has one message per frame.
 //!
 //! A write error is never deferred: the first one is kept in [`Recorder::error`] (with the
 //! file and the OS error), the writer is dropped (which closes the file best-effort, so what
@@ -117,6 +119,38 @@ impl FrameStatus {
             None | Some(Value::Null) => Ok(None),
             Some(v) => serde_json::from_value(v.clone()).map(Some),
         }
+    }
+}
+
+/// A plugin's writer of its own channel, called by [`record_now`] right after each frame
+/// (with the world at that frame's step). It finds the writer in [`Recorder::writer`] (adding
+/// its channel at the first call, e.g. by keeping the `ChannelHandle` in a resource of its
+/// own) and returns a write error as `Err`, which stops the recording and the run as a frame's
+/// write error does.
+pub type FrameWriter = std::sync::Arc<dyn Fn(&mut World) -> Result<(), String> + Send + Sync>;
+
+/// The [`FrameWriter`]s of plugins, run in registration order after every frame (a resource).
+///
+/// ```
+/// use magsep_plugins::recorder::FrameWriters;
+/// let mut world = bevy_ecs::world::World::new();
+/// FrameWriters::register(&mut world, "my_channel", |_world: &mut bevy_ecs::world::World| Ok(()));
+/// assert_eq!(world.resource::<FrameWriters>().0[0].0, "my_channel");
+/// ```
+#[derive(Resource, Default, Clone)]
+pub struct FrameWriters(pub Vec<(String, FrameWriter)>);
+
+impl FrameWriters {
+    /// Add `writer` under `name` (named in its errors) to the world's frame writers.
+    pub fn register(
+        world: &mut World,
+        name: impl Into<String>,
+        writer: impl Fn(&mut World) -> Result<(), String> + Send + Sync + 'static,
+    ) {
+        world
+            .get_resource_or_init::<FrameWriters>()
+            .0
+            .push((name.into(), std::sync::Arc::new(writer)));
     }
 }
 
@@ -257,6 +291,17 @@ pub fn record_now(world: &mut World) {
     match result {
         Some(Err(e)) => rec.fail(format!("frame at step {step}: {e}")),
         _ => rec.last_step = Some(step),
+    }
+    if let Some(writers) = world.get_resource::<FrameWriters>().cloned() {
+        for (name, write) in &writers.0 {
+            if world.resource::<Recorder>().writer.is_none() {
+                break;
+            }
+            if let Err(e) = write(world) {
+                let mut rec = world.resource_mut::<Recorder>();
+                rec.fail(format!("{name} at step {step}: {e}"));
+            }
+        }
     }
     if let Some(mut t) = world.get_resource_mut::<RecordTiming>() {
         let dt = started.elapsed().as_secs_f64();

@@ -20,8 +20,10 @@
 //! extra key/values) is stored as the MCAP metadata record [`METADATA_NAME`] (`magsep`) right
 //! after the file header, and an optional JSON summary as the metadata record
 //! [`SUMMARY_METADATA_NAME`] (`magsep.summary`). The writer ends a chunk and flushes the file after
-//! every frame and every message batch, so a process killed mid-run leaves every finished frame
-//! and message readable; the readers report such a file through [`Recording::truncated`] and
+//! every message batch and, by default, every frame (with
+//! [`RecordingWriter::buffer_frames`], as `magsep run` sets it, fast frames share a chunk for
+//! at most a bounded time and size), so a process killed mid-run leaves every flushed frame and
+//! message readable; the readers report such a file through [`Recording::truncated`] and
 //! [`RecordingReader::truncated`]. `recordings/README.md` documents the format for other
 //! readers.
 //!

@@ -233,7 +233,17 @@ impl Extensions {
         self
     }
 
-    /// Build `plugin` into every run.
+    /// Register a plugin scene kind too (a top-level section any scene may hold, spawned
+    /// with the scene; see [`crate::scene::SceneKind`]).
+    pub fn kind(mut self, kind: impl crate::scene::SceneKind + 'static) -> Self {
+        self.registry = self.registry.with_kind(kind);
+        self
+    }
+
+    /// Build `plugin` into every run, of every pipeline. A plugin that applies only to some
+    /// scenes decides in its `build`, e.g. from a resource its [`kind`](Self::kind) spawned
+    /// (`build` runs after the scene is spawned): a force registered into a pipeline that
+    /// cannot integrate it fails the schedule (exit 2, also from `magsep validate`).
     pub fn plugin(mut self, plugin: impl SimPlugin) -> Self {
         self.plugins.push(Arc::new(plugin));
         self

@@ -6,7 +6,7 @@ use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::overrides::{Override, apply_overrides};
 use crate::scene::{ExecutorChoice, RunOptions, Scene, parse_scene};
-use crate::sim::{SimError, StopFlag, run_scene};
+use crate::sim::{SimError, Simulation, StopFlag, run_scene};
 use indicatif::ProgressStyle;
 
 use super::output::{Input, check_file, print};
@@ -133,6 +133,17 @@ pub fn validate(
     let (text, overrides) = text_with_overrides(path, set)?;
     let scene = parse_with_overrides(ext, path, &text, overrides)?;
     let (estimate, budget) = memory(&scene, path, budget_gib)?;
+    if scene.pipeline.is_some() {
+        // spawn and build the schedule with this program's plugins, recording nothing: what
+        // `run` would refuse before its first step (a start region too small, a force the
+        // integrator cannot use) is refused here too
+        let options = RunOptions {
+            plugins: ext.plugins.clone(),
+            ..Default::default()
+        };
+        Simulation::from_scene(&scene, options)
+            .map_err(|e| CliError::input(format!("{} is invalid: {e}", path.display())))?;
+    }
     print(serde_json::json!({
         "valid": true,
         "scene": path.display().to_string(),
@@ -231,7 +242,11 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
     let summary = result.map_err(|e| match e.cause() {
         // a scene that validates but cannot be spawned (a start region too small for its
         // particles, a start box inside a fibre) is bad input too
-        SimError::NothingToRun | SimError::Spawn(_) => CliError::input(e.to_string()),
+        // (and a schedule refused before the first step: e.g. a plugin's force the scene's
+        // integrator cannot use)
+        SimError::NothingToRun | SimError::Spawn(_) | SimError::Schedule(_) => {
+            CliError::input(e.to_string())
+        }
         _ => CliError::runtime(e.to_string()),
     })?;
     print(serde_json::to_string_pretty(&summary).unwrap_or_default())?;

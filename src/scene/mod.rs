@@ -48,7 +48,7 @@ pub use sections::{
     GROUP_KEYS, OrientationSpec, ParticleGroup, RecordSection, ShapeSpec, SimulationSection,
     spheroid_semi_axes,
 };
-pub use spawn::{RecordEvery, SceneText, spawn_scene, spawn_scene_with};
+pub use spawn::{RecordEvery, SceneText, spawn_scene};
 
 /// A scene entity kind contributed by a plugin: a top-level key of the scene file.
 pub trait SceneKind: Send + Sync {
@@ -56,7 +56,9 @@ pub trait SceneKind: Send + Sync {
     fn key(&self) -> &str;
     /// Check `value` (found at `path`), pushing every problem.
     fn validate(&self, value: &toml::Value, path: &str, errors: &mut Vec<SceneError>);
-    /// Spawn what `value` describes (after validation).
+    /// Spawn what `value` describes (after validation): [`spawn_scene`] calls it after the
+    /// pipeline has spawned and before any plugin is built, so a plugin's `build` can read
+    /// the resources inserted here (every run, replay and resume of the scene goes this way).
     ///
     /// # Errors
     /// [`SpawnError`] if spawning fails at run time.
@@ -91,8 +93,29 @@ pub struct Scene {
     pub particles: Vec<ParticleGroup>,
     /// `[record]`.
     pub record: Option<RecordSection>,
-    /// Plugin kinds: (key, value) in file order.
-    pub extensions: Vec<(String, toml::Value)>,
+    /// Plugin kinds' sections, in file order: spawned by [`spawn_scene`] after the pipeline.
+    pub extensions: Vec<SceneExtension>,
+}
+
+/// A plugin kind's section of a scene: its top-level key, its value and the
+/// [`SceneKind`] (from the [`Registry`] the scene was parsed with) that validated it and spawns it.
+#[derive(Clone)]
+pub struct SceneExtension {
+    /// The top-level key.
+    pub key: String,
+    /// The section's value.
+    pub value: toml::Value,
+    /// The kind registered for `key`.
+    pub kind: Arc<dyn SceneKind>,
+}
+
+impl std::fmt::Debug for SceneExtension {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneExtension")
+            .field("key", &self.key)
+            .field("value", &self.value)
+            .finish_non_exhaustive()
+    }
 }
 
 impl std::fmt::Debug for Scene {

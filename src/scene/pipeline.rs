@@ -6,7 +6,8 @@
 //! resume. Shared code (the scene parser, the simulation driver, the recorder, replay and the
 //! CLI) only calls these hooks; it never names a pipeline. The built-in pipelines are
 //! registered in `magsep::pipelines` (one line each); a user's binary adds its own with
-//! [`Registry::with_pipeline`] and hands the registry to `magsep::cli::main_with`.
+//! [`Registry::with_pipeline`] and hands the registry to `magsep::cli::main_with` (through
+//! `magsep::cli::Extensions::pipeline`).
 
 use std::any::Any;
 use std::fmt;
@@ -286,8 +287,8 @@ pub struct RunInfo {
 /// that runs from scenes through `magsep run`, `validate`, `info`, `replay` and the builder.
 ///
 /// Only [`name`](Self::name), [`parse`](Self::parse), [`spawn`](Self::spawn),
-/// [`plugins`](Self::plugins), [`is_finished`](Self::is_finished) and
-/// [`summary`](Self::summary) are required; see `examples/langevin_trap` for a complete
+/// [`plugins`](Self::plugins), [`is_finished`](Self::is_finished),
+/// [`summary`](Self::summary) and [`replay`](Self::replay) are required; see `examples/langevin_trap` for a complete
 /// pipeline written outside the crate.
 pub trait Pipeline: Send + Sync + 'static {
     /// The name in `[simulation] pipeline = "..."` (and in recordings).
@@ -464,11 +465,8 @@ impl Registry {
     }
 
     /// The scene kind registered for `key`.
-    pub fn kind(&self, key: &str) -> Option<&dyn SceneKind> {
-        self.kinds
-            .iter()
-            .find(|k| k.key() == key)
-            .map(|k| k.as_ref())
+    pub fn kind(&self, key: &str) -> Option<&Arc<dyn SceneKind>> {
+        self.kinds.iter().find(|k| k.key() == key)
     }
 
     /// Keys of the registered scene kinds.

@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use magsep_components::prelude::*;
 use magsep_systems::RunSeed;
 
-use super::{Scene, SceneKind, SpawnError};
+use super::{Scene, SpawnError};
 
 /// The scene file's text, verbatim (a resource).
 #[derive(Resource, Debug, Clone)]
@@ -16,25 +16,13 @@ pub struct RecordEvery(pub u64);
 
 /// Spawn `scene` with `seed`: the pipeline's particles and resources, then what every
 /// pipeline expects (`RunSeed`, `Health`, `SceneText`, `RecordEvery`, the fibres as entities,
-/// `ExternalField`) and the plugin scene kinds.
+/// `ExternalField`) and then the plugin kinds' sections ([`Scene::extensions`], each by the
+/// [`SceneKind`](super::SceneKind) that validated it).
 ///
 /// # Errors
 /// [`SpawnError`] from the pipeline (e.g. random insertion failed) or a plugin kind; a
 /// field-only scene has nothing to spawn.
 pub fn spawn_scene(scene: &Scene, world: &mut World, seed: u64) -> Result<(), SpawnError> {
-    spawn_scene_with(scene, world, seed, &[])
-}
-
-/// [`spawn_scene`] with plugin scene kinds.
-///
-/// # Errors
-/// As [`spawn_scene`], and the kinds' own errors.
-pub fn spawn_scene_with(
-    scene: &Scene,
-    world: &mut World,
-    seed: u64,
-    kinds: &[&dyn SceneKind],
-) -> Result<(), SpawnError> {
     let Some(pipeline) = &scene.pipeline else {
         return Err(SpawnError::Other(
             "a field-only scene has nothing to spawn".into(),
@@ -66,10 +54,8 @@ pub fn spawn_scene_with(
         flux_density: b_ext,
         tolerance,
     });
-    for (key, value) in &scene.extensions {
-        if let Some(kind) = kinds.iter().find(|k| k.key() == key) {
-            kind.spawn(value, world)?;
-        }
+    for ext in &scene.extensions {
+        ext.kind.spawn(&ext.value, world)?;
     }
     Ok(())
 }

@@ -130,16 +130,28 @@ impl SceneKind for Magnets {
             ));
         }
     }
-    fn spawn(&self, _value: &toml::Value, _world: &mut World) -> Result<(), SpawnError> {
+    fn spawn(&self, value: &toml::Value, world: &mut World) -> Result<(), SpawnError> {
+        let strength = value.get("strength").and_then(|v| v.as_float());
+        world.insert_resource(MagnetStrength(strength.unwrap_or(f64::NAN)));
         Ok(())
     }
 }
+
+#[derive(Resource, Debug, PartialEq)]
+struct MagnetStrength(f64);
 
 #[test]
 fn plugins_register_new_scene_kinds() {
     let reg = Registry::default().with_kind(Magnets);
     let s = parse_scene(&format!("{GOOD}\n[magnets]\nstrength = 1.5\n"), &reg).unwrap();
     assert_eq!(s.extensions.len(), 1);
+    // the kind's section is spawned with the scene (a plugin's build can read it)
+    let mut world = World::new();
+    crate::scene::spawn_scene(&s, &mut world, 1).unwrap();
+    assert_eq!(
+        world.get_resource::<MagnetStrength>(),
+        Some(&MagnetStrength(1.5))
+    );
     let e = parse_scene(&format!("{GOOD}\n[magnets]\nstrength = -1.0\n"), &reg).unwrap_err();
     assert_eq!(e.0[0].path, "magnets.strength");
 }

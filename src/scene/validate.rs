@@ -9,7 +9,7 @@ use super::fibre_packing::FibrePackingSpec;
 use super::fibres::{ExternalFieldSection, FibreSpec, validate_fibres};
 use super::pipeline::{ParseContext, Pipeline, Registry};
 use super::sections::*;
-use super::{COMMON_KEYS, Scene, SceneError};
+use super::{COMMON_KEYS, Scene, SceneError, SceneExtension};
 
 /// The particle group at `path` typed: keys [`ParticleGroup`] does not type go to its
 /// `extra` table.
@@ -285,7 +285,9 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
             errors.push(SceneError::new(
                 "simulation.pipeline",
                 format!(
-                    "unknown pipeline \"{}\"; registered: {}",
+                    "unknown pipeline \"{}\"; registered: {} (a pipeline of a plugin crate \
+                     runs with the program built with it, which registers it through \
+                     magsep::cli::Extensions)",
                     s.pipeline,
                     names.join(", ")
                 ),
@@ -343,8 +345,14 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
             other => match registry.kind(other) {
                 Some(kind) => {
                     kind.validate(value, other, &mut errors);
-                    extensions.push((other.to_string(), value.clone()));
+                    extensions.push(SceneExtension {
+                        key: other.to_string(),
+                        value: value.clone(),
+                        kind: kind.clone(),
+                    });
                 }
+                // the sections of a pipeline this program does not know: its error says so
+                None if simulation.as_ref().is_some_and(|_| pipeline.is_none()) => {}
                 None => {
                     let owned = owners(registry, current, |p| p.sections().contains(&other));
                     if owned.is_empty() {
@@ -352,7 +360,7 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
                             COMMON_KEYS.iter().map(|s| s.to_string()).collect();
                         match &pipeline {
                             Some(p) => keys.extend(p.sections().iter().map(|s| s.to_string())),
-                            None => keys.push("(the keys of the [simulation] pipeline)".into()),
+                            None => keys.push("the sections of the [simulation] pipeline".into()),
                         }
                         keys.extend(registry.kind_keys());
                         errors.push(SceneError::new(

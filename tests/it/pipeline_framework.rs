@@ -161,3 +161,107 @@ fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
     let summary = resume(&path, &Default::default(), None, &[plugin], &NoProgress).unwrap();
     assert_eq!(summary["steps"], 100);
 }
+
+/// The handle of [`StepChannelPlugin`]'s channel, once added.
+#[derive(Resource, Clone, Copy)]
+struct StepChannel(magsep::plugins::record::ChannelHandle);
+
+/// A plugin channel on a shipped pipeline: one message (the step, little-endian) per frame,
+/// through a frame writer; `fail_at` makes the writer fail at that step.
+#[derive(Clone)]
+struct StepChannelPlugin {
+    fail_at: Option<u64>,
+}
+
+impl SimPlugin for StepChannelPlugin {
+    fn build(&self, app: &mut SimApp) {
+        let fail_at = self.fail_at;
+        magsep::plugins::recorder::FrameWriters::register(
+            &mut app.world,
+            "/test/step",
+            move |world: &mut World| {
+                let step = world.resource::<StepClock>().step;
+                if Some(step) == fail_at {
+                    return Err("the disk is full (test)".into());
+                }
+                let known = world.get_resource::<StepChannel>().map(|c| c.0);
+                let mut rec = world.resource_mut::<magsep::plugins::recorder::Recorder>();
+                let Some(w) = rec.writer.as_mut() else {
+                    return Ok(());
+                };
+                let h = match known {
+                    Some(h) => h,
+                    None => w
+                        .add_channel("/test/step", "", "", &[], "u64le")
+                        .map_err(|e| e.to_string())?,
+                };
+                w.write_message(h, step, &step.to_le_bytes())
+                    .map_err(|e| e.to_string())?;
+                world.insert_resource(StepChannel(h));
+                Ok(())
+            },
+        );
+    }
+}
+
+fn step_messages(path: &std::path::Path) -> Vec<u64> {
+    let mut reader = magsep::plugins::record::RecordingReader::open(path).unwrap();
+    reader
+        .messages(Some("/test/step"))
+        .map(|m| u64::from_le_bytes(m.unwrap().data.as_slice().try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn a_plugin_channel_has_one_message_per_frame_step_0_final_and_interrupted_included() {
+    let scene = parse_scene(&brownian(), &Default::default()).unwrap();
+    // the whole run: frames 0, 30, 60, 90 and the final 100
+    let path = tmp("step_channel.mcap");
+    Simulation::builder(&scene)
+        .add_plugin(StepChannelPlugin { fail_at: None })
+        .record(&path)
+        .build()
+        .unwrap()
+        .run(|_| {})
+        .unwrap();
+    let frames: Vec<u64> = read_recording(&path)
+        .unwrap()
+        .frames
+        .iter()
+        .map(|f| f.step)
+        .collect();
+    assert_eq!(frames, [0, 30, 60, 90, 100]);
+    assert_eq!(step_messages(&path), frames);
+    // stopped after step 45: its last frame has its message too
+    let path = tmp("step_channel_stopped.mcap");
+    let stop = magsep::sim::StopFlag::new();
+    let mut sim = Simulation::builder(&scene)
+        .add_plugin(StepChannelPlugin { fail_at: None })
+        .record(&path)
+        .stop_flag(stop.clone())
+        .build()
+        .unwrap();
+    sim.run(|w| {
+        if w.resource::<StepClock>().step == 45 {
+            stop.request_stop("test");
+        }
+    })
+    .unwrap();
+    assert_eq!(step_messages(&path), [0, 30, 45]);
+    // a failing channel stops the run as a frame's write error does, naming the channel
+    let path = tmp("step_channel_failed.mcap");
+    let err = Simulation::builder(&scene)
+        .add_plugin(StepChannelPlugin { fail_at: Some(60) })
+        .record(&path)
+        .build()
+        .unwrap()
+        .run(|_| {})
+        .unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("/test/step at step 60") && msg.contains("disk is full"),
+        "{msg}"
+    );
+    assert_eq!(err.partial_summary().unwrap()["steps"], 60);
+    assert_eq!(step_messages(&path), [0, 30]);
+}

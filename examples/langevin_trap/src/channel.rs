@@ -4,24 +4,21 @@
 //! from the file alone (e.g. Python's `mcap-protobuf-support`, see
 //! `tests/python/read_custom_channel.py`).
 //!
-//! | plugin | set | system | touches |
+//! | plugin | runs | function | touches |
 //! |---|---|---|---|
-//! | [`EnergyChannelPlugin`] | `Record` (after `record_frame`) | [`write_energy`] | `Recorder`, `EnergyChannel` |
+//! | [`EnergyChannelPlugin`] | after every frame the recorder writes (a `FrameWriter`) | [`write_energy`] | `Recorder`, `EnergyChannel` |
 //!
-//! The channel is added by [`Pipeline::prepare_recording`](magsep::scene::Pipeline), which
-//! also writes the message of the first frame; [`write_energy`] writes one at every step the
-//! recorder writes a frame (`step % every == 0`) and at the last step of the run.
+//! [`write_energy`] adds the channel at the first frame and writes one message per frame:
+//! the scheduled ones, step 0, the last step and the last frame of an interrupted run alike.
 
 use magsep::bevy_ecs;
 use magsep::bevy_ecs::prelude::*;
 use magsep::components::prelude::*;
 use magsep::plugins::app::{SimApp, SimPlugin};
 use magsep::plugins::record::{
-    ChannelHandle, ProtoField, ProtoType, ProtobufSchema, RecordError, RecordingWriter,
-    protobuf_schema,
+    ChannelHandle, ProtoField, ProtoType, ProtobufSchema, RecordError, protobuf_schema,
 };
-use magsep::plugins::recorder::{Recorder, record_frame};
-use magsep::systems::sets::SimSystems;
+use magsep::plugins::recorder::{FrameWriters, Recorder};
 use prost::Message as _;
 
 use crate::dynamics::{TrapConfig, displacements};
@@ -75,10 +72,9 @@ pub fn energy_schema() -> Result<ProtobufSchema, RecordError> {
     )
 }
 
-/// The channel of this run (a resource): its handle, or why it could not be added (reported
-/// by [`write_energy`] as the recorder's error, which fails the run).
-#[derive(Resource, Debug, Clone)]
-pub struct EnergyChannel(pub Result<ChannelHandle, String>);
+/// The channel of this run, once added (a resource).
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct EnergyChannel(pub ChannelHandle);
 
 /// MCAP log time \[ns\] of a frame at `step` and `time` \[s\]: the rule of the `/state` frames
 /// (`magsep::plugins::record::log_time_ns`), so a message and its frame share a log time.
@@ -111,75 +107,47 @@ fn rows(world: &mut World) -> Vec<(ParticleId, magsep::glam::DVec3)> {
     q.iter(world).map(|(id, p)| (*id, p.0)).collect()
 }
 
-/// Add the channel to `writer`, store its handle in [`EnergyChannel`] and write the message
-/// of the current state (the first frame). Called by `Pipeline::prepare_recording`.
-pub fn open_energy_channel(world: &mut World, writer: &mut RecordingWriter) {
-    let handle = energy_schema()
-        .and_then(|s| writer.add_protobuf_channel(ENERGY_TOPIC, &s))
-        .map_err(|e| format!("{ENERGY_TOPIC}: {e}"));
-    let first = match (
-        &handle,
+/// A [`FrameWriter`](magsep::plugins::recorder::FrameWriter): the energy message of the frame
+/// the recorder has just written, adding the channel at the first frame.
+///
+/// # Errors
+/// The channel could not be added or the message not written (the recorder then stops the
+/// run, as for a frame's write error).
+pub fn write_energy(world: &mut World) -> Result<(), String> {
+    let (Some(config), Some(clock)) = (
         world.get_resource::<TrapConfig>().copied(),
         world.get_resource::<StepClock>().copied(),
-    ) {
-        (Ok(h), Some(config), Some(clock)) => {
-            let m = energy_message(&config, &clock, &rows(world));
-            writer
-                .write_message(*h, log_time(m.step, m.time_s), &m.encode_to_vec())
-                .map_err(|e| format!("{ENERGY_TOPIC}: {e}"))
-        }
-        _ => Ok(()),
+    ) else {
+        return Ok(());
     };
-    world.insert_resource(EnergyChannel(first.and(handle)));
+    let m = energy_message(&config, &clock, &rows(world));
+    let known = world.get_resource::<EnergyChannel>().map(|c| c.0);
+    let mut recorder = world.resource_mut::<Recorder>();
+    let Some(writer) = recorder.writer.as_mut() else {
+        return Ok(());
+    };
+    let handle = match known {
+        Some(h) => h,
+        None => energy_schema()
+            .and_then(|s| writer.add_protobuf_channel(ENERGY_TOPIC, &s))
+            .map_err(|e| format!("{ENERGY_TOPIC}: {e}"))?,
+    };
+    writer
+        .write_message(handle, log_time(m.step, m.time_s), &m.encode_to_vec())
+        .map_err(|e| format!("{ENERGY_TOPIC}: {e}"))?;
+    if known.is_none() {
+        world.insert_resource(EnergyChannel(handle));
+    }
+    Ok(())
 }
 
-/// Record: after the recorder's frame, write the energy message when a frame is due
-/// (`step % every == 0`, and the last step of the run, which the driver records).
-pub fn write_energy(
-    config: Res<TrapConfig>,
-    clock: Res<StepClock>,
-    channel: Option<Res<EnergyChannel>>,
-    recorder: Option<ResMut<Recorder>>,
-    q: Query<(&ParticleId, &Position)>,
-) {
-    let (Some(channel), Some(mut recorder)) = (channel, recorder) else {
-        return;
-    };
-    if recorder.writer.is_none() || recorder.error.is_some() {
-        return;
-    }
-    let handle = match &channel.0 {
-        Ok(h) => *h,
-        Err(e) => {
-            recorder.error = Some(e.clone());
-            recorder.writer = None;
-            return;
-        }
-    };
-    let due = clock.step.is_multiple_of(recorder.every.max(1)) || clock.step >= config.0.steps;
-    if !due {
-        return;
-    }
-    let rows: Vec<_> = q.iter().map(|(id, p)| (*id, p.0)).collect();
-    let m = energy_message(&config, &clock, &rows);
-    let result = recorder
-        .writer
-        .as_mut()
-        .map(|w| w.write_message(handle, log_time(m.step, m.time_s), &m.encode_to_vec()));
-    if let Some(Err(e)) = result {
-        recorder.error = Some(format!("{ENERGY_TOPIC}: {e}"));
-        recorder.writer = None;
-    }
-}
-
-/// Writes [`ENERGY_TOPIC`] messages (needs the `RecordPlugin` for the `Recorder` and its
-/// `record_frame` system).
+/// Writes [`ENERGY_TOPIC`] messages: registers [`write_energy`] as a frame writer, so the
+/// channel has one message for every frame the recorder writes.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct EnergyChannelPlugin;
 
 impl SimPlugin for EnergyChannelPlugin {
     fn build(&self, app: &mut SimApp) {
-        app.schedule
-            .add_systems(write_energy.after(record_frame).in_set(SimSystems::Record));
+        FrameWriters::register(&mut app.world, ENERGY_TOPIC, write_energy);
     }
 }

@@ -115,8 +115,7 @@ impl Pipeline for LangevinTrapPipeline {
         summary::summary_of(world, run.seed, run.wall_time_s)
     }
 
-    fn prepare_recording(&self, world: &mut World, writer: &mut RecordingWriter) {
-        channel::open_energy_channel(world, writer);
+    fn prepare_recording(&self, world: &mut World, _writer: &mut RecordingWriter) {
         world
             .get_resource_or_init::<FrameStatusProviders>()
             .set(STATUS_KEY, |w| {
@@ -179,3 +178,9 @@ pub fn apply_frame(world: &mut World, frame: &ParticleFrame) -> Result<(), Repla
     world.insert_resource(stats);
     Ok(())
 }
+
+/// The plugin guide's snippets (`docs/writing-a-plugin.md`), compiled and run as doctests of
+/// this crate, which depends on `magsep` alone: they compile in a user's crate as written.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/writing-a-plugin.md")]
+pub struct PluginGuideDoctests;

@@ -133,3 +133,31 @@ fn pipeline_specific_keys_are_checked() {
     let packing = "[simulation]\npipeline = \"packing\"\n[container]\nkind = \"periodic_box\"\n[[particles]]\ncount = 3\nshape = { kind = \"sphere\", radius = 1.0 }\nmoment = { kind = \"saturated\", moment = 1.0 }\n";
     assert!(paths(packing).contains(&"particles[0].moment".to_string()));
 }
+
+#[test]
+fn step_control_keys_default_one_by_one() {
+    let control = |table: &str| {
+        let text = GOOD.replace("runs = 3\n", &format!("runs = 3\nstep_control = {table}\n"));
+        let s = parse_scene(&text, &Default::default()).unwrap();
+        s.section::<BrownianSection>()
+            .unwrap()
+            .config()
+            .step_control
+    };
+    assert_eq!(control("{ kind = \"adaptive\" }"), StepControl::default());
+    assert_eq!(
+        control("{ kind = \"multirate\", tolerance = 0.05 }"),
+        StepControl::Multirate {
+            tolerance: 0.05,
+            max_displacement: 0.5,
+            max_depth: 24
+        }
+    );
+    assert_eq!(
+        paths(&GOOD.replace(
+            "runs = 3\n",
+            "runs = 3\nstep_control = { kind = \"adaptive\", max_depth = 99 }\n"
+        )),
+        ["brownian.step_control.max_depth"]
+    );
+}
