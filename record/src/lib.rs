@@ -170,3 +170,13 @@ pub enum RecordError {
         detail: String,
     },
 }
+
+/// "N complete frames read" ("1 complete frame read"): how a damaged file's messages say what
+/// was recovered.
+pub fn complete_frames_read(n: u64) -> String {
+    if n == 1 {
+        "1 complete frame read".into()
+    } else {
+        format!("{n} complete frames read")
+    }
+}

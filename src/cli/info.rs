@@ -68,7 +68,10 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
         // damage before the first frame: the header, metadata and channels read before it
         // are still printed (and the exit code says damaged)
         Some(e) => {
-            let msg = format!("{e}; reading stopped there: {frames} complete frames read");
+            let msg = format!(
+                "{e}; reading stopped there: {}",
+                crate::plugins::record::complete_frames_read(frames as u64)
+            );
             (Some(msg.clone()), Some(msg))
         }
         None => (
@@ -250,9 +253,10 @@ pub fn replay(ext: &Extensions, path: &Path) -> Result<(), CliError> {
     let (summary, rec) = replay_with(path, &ext.registry).map_err(|e| replay_error(path, e))?;
     if let Some(d) = &rec.damaged {
         eprint(format!(
-            "warning: {} is damaged: {d}; replayed its {} complete frames",
+            "warning: {} is damaged: {d}; replayed its {} complete frame{}",
             path.display(),
-            rec.frames.len()
+            rec.frames.len(),
+            if rec.frames.len() == 1 { "" } else { "s" }
         ));
     }
     print(serde_json::to_string_pretty(&summary).unwrap_or_default())

@@ -123,8 +123,8 @@ pub fn read_last_frame(path: &Path) -> Result<LastFrame, RecordError> {
         Some(e) if last.frames == 0 => return Err(e),
         Some(e) => {
             let msg = format!(
-                "{e}; reading stopped there: {} complete frames read",
-                last.frames
+                "{e}; reading stopped there: {}",
+                crate::complete_frames_read(last.frames as u64)
             );
             last.truncated = Some(msg.clone());
             last.damaged = Some(msg);
@@ -160,7 +160,10 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
         ),
         Some(e) if n == 0 => return Err(e),
         Some(e) => {
-            let msg = format!("{e}; reading stopped there: {n} complete frames read");
+            let msg = format!(
+                "{e}; reading stopped there: {}",
+                crate::complete_frames_read(n as u64)
+            );
             (Some(msg.clone()), Some(msg))
         }
     };

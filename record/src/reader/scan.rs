@@ -89,8 +89,9 @@ struct Scan<'a, R> {
 impl<R: Read + Seek> Scan<'_, R> {
     fn truncated(&self, what: String) -> Stop {
         Stop::Truncated(format!(
-            "file ends at byte {} {what}: {} complete frames read",
-            self.src.len, self.layout.state_messages
+            "file ends at byte {} {what}: {}",
+            self.src.len,
+            crate::complete_frames_read(self.layout.state_messages as u64)
         ))
     }
 
