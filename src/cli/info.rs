@@ -70,7 +70,7 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
         Some(e) => {
             let msg = format!(
                 "{e}; reading stopped there: {}",
-                crate::plugins::record::complete_frames_read(frames as u64)
+                crate::plugins::record::complete_frames_read(frames)
             );
             (Some(msg.clone()), Some(msg))
         }
@@ -238,13 +238,39 @@ fn schedule_lines(m: &RecordingMetadata) -> Vec<String> {
     sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
     sets.into_iter()
         .map(|(set, systems)| {
-            let short: Vec<&str> = systems
-                .iter()
-                .map(|s| s.rsplit("::").next().unwrap_or(s))
-                .collect();
+            let short: Vec<String> = systems.iter().map(|s| short_name(s)).collect();
             format!("  {set:<12} {}", short.join(", "))
         })
         .collect()
+}
+
+/// A system's name without module paths, also inside generics:
+/// `a::clear_contribution<b::PullForce>` gives `clear_contribution<PullForce>`.
+fn short_name(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    let mut ident = String::new();
+    for c in name.chars() {
+        match c {
+            ':' => ident.clear(),
+            c if c.is_alphanumeric() || c == '_' => ident.push(c),
+            c => {
+                out.push_str(&ident);
+                ident.clear();
+                out.push(c);
+            }
+        }
+    }
+    out + &ident
+}
+
+#[test]
+fn system_names_lose_their_paths_inside_generics_too() {
+    assert_eq!(
+        short_name("magsep_systems::forces::clear_contribution<myext::pull::PullForce>"),
+        "clear_contribution<PullForce>"
+    );
+    assert_eq!(short_name("advance_clock"), "advance_clock");
+    assert_eq!(short_name("a::f<b::X, c::Y<d::Z>>"), "f<X, Y<Z>>");
 }
 
 /// `magsep replay`: the summary of the recording's complete frames; a damaged file is

@@ -124,7 +124,7 @@ pub fn read_last_frame(path: &Path) -> Result<LastFrame, RecordError> {
         Some(e) => {
             let msg = format!(
                 "{e}; reading stopped there: {}",
-                crate::complete_frames_read(last.frames as u64)
+                crate::complete_frames_read(last.frames)
             );
             last.truncated = Some(msg.clone());
             last.damaged = Some(msg);

@@ -91,7 +91,7 @@ impl<R: Read + Seek> Scan<'_, R> {
         Stop::Truncated(format!(
             "file ends at byte {} {what}: {}",
             self.src.len,
-            crate::complete_frames_read(self.layout.state_messages as u64)
+            crate::complete_frames_read(self.layout.state_messages)
         ))
     }
 
