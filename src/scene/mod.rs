@@ -147,6 +147,46 @@ pub fn parse_scene(text: &str, registry: &Registry) -> Result<Scene, SceneErrors
     validate::parse_and_validate(text, registry).map_err(SceneErrors)
 }
 
+/// Parse a scene with overrides `PATH=VALUE` applied first (the `--set` of the CLI, e.g.
+/// `"brownian.duration=0.01"`, `"particles[0].count=150"`), recorded in
+/// [`Scene::overrides`] and so in the recording's metadata.
+///
+/// ```
+/// let text = std::fs::read_to_string("scenes/spheres_500.toml").unwrap();
+/// let registry = magsep::scene::Registry::default();
+/// let scene =
+///     magsep::scene::parse_scene_with_overrides(&text, &["particles[0].count=50"], &registry)
+///         .unwrap();
+/// assert_eq!(scene.total_particles(), 50);
+/// assert_eq!(scene.overrides, ["particles[0].count=50"]);
+/// let bad = magsep::scene::parse_scene_with_overrides(&text, &["particles[0].count=-1"], &registry);
+/// assert_eq!(bad.unwrap_err().0[0].path, "particles[0].count");
+/// ```
+///
+/// # Errors
+/// [`SceneErrors`]: malformed overrides, or the scene's problems after applying them.
+pub fn parse_scene_with_overrides(
+    text: &str,
+    set: &[&str],
+    registry: &Registry,
+) -> Result<Scene, SceneErrors> {
+    let mut parsed = Vec::new();
+    let mut errors = Vec::new();
+    for arg in set {
+        match overrides::Override::parse(arg) {
+            Ok(o) => parsed.push(o),
+            Err(e) => errors.push(e),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(SceneErrors(errors));
+    }
+    let text = overrides::apply_overrides(text, &parsed)?;
+    let mut scene = parse_scene(&text, registry)?;
+    scene.overrides = parsed.iter().map(ToString::to_string).collect();
+    Ok(scene)
+}
+
 /// Read and parse a scene file.
 ///
 /// # Errors
