@@ -55,6 +55,16 @@ pub struct EngineConfig {
     /// the residual rule alone. Default: 0 (the residual rule alone). Range: ≥ 0.
     #[serde(default)]
     pub resting_floor: f64,
+    /// Maximum sweeps of the overlap projection of spheres with momentum (on two blocks side by
+    /// side; used with the NNCG resting solve, `nncg_sweeps > 0`, from 512 spheres), at most
+    /// `projection_sweeps`. Default: 30. Range: ≥ 0.
+    #[serde(default = "default_nncg_projection_sweeps")]
+    pub nncg_projection_sweeps: u32,
+}
+
+/// The default of [`EngineConfig::nncg_projection_sweeps`].
+fn default_nncg_projection_sweeps() -> u32 {
+    30
 }
 
 impl Default for EngineConfig {
@@ -71,6 +81,7 @@ impl Default for EngineConfig {
             warm_start: true,
             nncg_sweeps: 35,
             resting_floor: 0.0,
+            nncg_projection_sweeps: default_nncg_projection_sweeps(),
         }
     }
 }

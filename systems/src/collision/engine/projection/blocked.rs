@@ -20,6 +20,13 @@
 //! than the positions) and its evaluation, which would only find it apart, is skipped. Evaluating
 //! an apart pair changes no position and no overlap, so the result is bitwise that of the
 //! stamps alone (`Scratch::plain`, a test compares the two).
+//!
+//! Momentum (as in the NNCG resting solve, [`super::super::resting_fast::blocked`]): after a
+//! correcting sweep the particles' displacements `s_k` give `β = |s_k|²/|s_{k−1}|²`; before the
+//! next correcting sweep the particles move on by `β p_{k−1}` (`β ≤ 1`; otherwise the direction
+//! restarts) and `p_k = s_k + β p_{k−1}`. The sweep that follows projects the pairs again, so
+//! the projection still ends with a plain forward sweep. Each particle's momentum move counts as
+//! a move (stamp and travel). `Scratch::no_momentum` gives the plain sweeps (tests).
 
 use glam::DVec3;
 
@@ -53,6 +60,54 @@ pub(in crate::collision::engine) struct Scratch {
     slack: [Vec<f64>; 3],
     /// Skip pairs by the stamps alone (the reference of the slack skip; tests).
     pub(in crate::collision::engine) plain: bool,
+    /// Plain Gauss–Seidel sweeps without the momentum step (the reference of the momentum;
+    /// tests).
+    pub(in crate::collision::engine) no_momentum: bool,
+    /// Per local particle, its position at the start of the current sweep's passes [m].
+    start: Vec<DVec3>,
+    /// Per local particle, the displacement of the last sweep's passes (`s`, x) and the
+    /// search direction (`p`, y) [m].
+    step: Vec<[DVec3; 2]>,
+    /// `|s|²` of the last sweep, of the one before [m²], and whether a sweep recorded `s`.
+    norm: [f64; 2],
+    pending: bool,
+}
+
+/// The momentum step over particles `x` (see the module header): `x += β p` (unless
+/// `restart`), `p = s + β p`; stamps and travel of moved particles updated.
+fn momentum(
+    x: &mut [DVec3],
+    step: &mut [[DVec3; 2]],
+    moved: &mut [u64],
+    travel: &mut [f64],
+    beta: f64,
+    restart: bool,
+    stamp: u64,
+) {
+    for (i, [s, p]) in step.iter_mut().enumerate() {
+        if restart {
+            *p = *s;
+            continue;
+        }
+        let d = *p * beta;
+        let before = x[i];
+        x[i] += d;
+        if x[i] != before {
+            moved[i] = stamp;
+            travel[i] += d.length();
+        }
+        *p = *s + d;
+    }
+}
+
+/// `s = x − start` over a half; returns `|s|²`.
+fn displacement(x: &[DVec3], start: &[DVec3], step: &mut [[DVec3; 2]]) -> f64 {
+    let mut norm = 0.0;
+    for ((x, a), [s, _]) in x.iter().zip(start).zip(step.iter_mut()) {
+        *s = *x - *a;
+        norm += s.length_squared();
+    }
+    norm
 }
 
 /// The shared read-only inputs of a pass.
@@ -164,8 +219,66 @@ fn walls_pass(
 }
 
 impl Scratch {
+    /// Before a correcting sweep: the momentum step from the last sweep's displacement (if
+    /// any), and the positions the sweep starts from.
+    fn before_sweep(&mut self, phase: &mut u64) {
+        let n0 = self.halves.n0;
+        if self.pending {
+            let [last, prev] = self.norm;
+            let beta = last / prev;
+            let restart = beta.partial_cmp(&1.0).is_none_or(|o| o.is_gt());
+            *phase += 1;
+            let stamp = (*phase << 32) | 1;
+            let (x0, x1) = self.x.split_at_mut(n0);
+            let (q0, q1) = self.step.split_at_mut(n0);
+            let (m0, m1) = self.moved.split_at_mut(n0);
+            let (t0, t1) = self.travel.split_at_mut(n0);
+            rayon::join(
+                || momentum(x0, q0, m0, t0, beta, restart, stamp),
+                || momentum(x1, q1, m1, t1, beta, restart, stamp),
+            );
+        }
+        self.start.clear();
+        self.start.extend_from_slice(&self.x);
+    }
+
+    /// After a correcting sweep: its displacement and `|s|²`.
+    fn after_sweep(&mut self) {
+        let n0 = self.halves.n0;
+        let (x0, x1) = self.x.split_at(n0);
+        let (a0, a1) = self.start.split_at(n0);
+        let (q0, q1) = self.step.split_at_mut(n0);
+        let (s0, s1) = rayon::join(|| displacement(x0, a0, q0), || displacement(x1, a1, q1));
+        let prev = if self.pending {
+            self.norm[0]
+        } else {
+            f64::INFINITY
+        };
+        self.norm = [s0 + s1, prev];
+        self.pending = true;
+    }
+
     /// One sweep (see the module header); `phase` counts the phases run so far.
     fn sweep(
+        &mut self,
+        domain: &CollisionDomain,
+        fix: bool,
+        backward: bool,
+        phase: &mut u64,
+    ) -> f64 {
+        let momentum = fix && !self.no_momentum;
+        if momentum {
+            self.before_sweep(phase);
+        }
+        let worst = self.passes(domain, fix, backward, phase);
+        if momentum {
+            self.after_sweep();
+        }
+        worst
+    }
+
+    /// The passes of one sweep (see the module header).
+    fn passes(
         &mut self,
         domain: &CollisionDomain,
         fix: bool,
@@ -281,11 +394,15 @@ impl Sim<'_, '_> {
         s.travel.resize(n, 0.0);
         s.wall_apart.clear();
         s.wall_apart.resize(n * self.domain.planes.len(), 0);
+        s.step.clear();
+        s.step.resize(n, [DVec3::ZERO; 2]);
+        s.pending = false;
         let mut phase = 0;
-        let (max, tol) = (
-            self.cfg.projection_sweeps as usize,
-            self.cfg.projection_tolerance,
-        );
+        let max = self
+            .cfg
+            .projection_sweeps
+            .min(self.cfg.nncg_projection_sweeps);
+        let (max, tol) = (max as usize, self.cfg.projection_tolerance);
         let out = super::budget(max, tol, |fix, backward| {
             s.sweep(self.domain, fix, backward, &mut phase)
         });

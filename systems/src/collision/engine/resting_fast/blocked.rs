@@ -294,6 +294,8 @@ pub(in crate::collision::engine) struct Layout {
     pub(in crate::collision::engine) halves: Halves,
     /// Local particle index → particle index.
     pub(in crate::collision::engine) perm: Vec<u32>,
+    /// Particle index → local index.
+    local: Vec<u32>,
     /// The contacts in block order, with local indices.
     pub(in crate::collision::engine) grouped: Vec<Contact>,
     /// Per grouped contact, its index in the caller's contacts.
@@ -305,6 +307,11 @@ pub(in crate::collision::engine) struct Layout {
 /// Splits `contacts` (in sweep order; `n` particles at `positions`, walls `j ≥ n`) into blocks
 /// (see the module header; the cut at the median of the contacts' first particles): fills
 /// `s.grouped`, `s.src` and `s.perm` and returns the layout.
+///
+/// Local indices: within each half, the particles in the order a forward sweep of the half's
+/// block first touches them, then the half's other particles in particle order. A sweep then
+/// walks its bodies nearly in memory order; the arithmetic does not depend on where a body is
+/// stored, so the solve is bitwise that of any other numbering.
 pub(in crate::collision::engine) fn layout(
     contacts: &[Contact],
     positions: &[DVec3],
@@ -313,43 +320,63 @@ pub(in crate::collision::engine) fn layout(
 ) -> Blocks {
     let n = positions.len();
     let m = contacts.len();
-    s.perm.clear();
     s.grouped.clear();
     s.src.clear();
-    if m < SPLIT_MIN_CONTACTS {
-        s.perm.extend(0..n as u32);
-        s.grouped.extend_from_slice(contacts);
-        s.src.extend(0..m as u32);
-        return Blocks {
-            n,
-            n0: n,
-            g0: m,
-            g1: 0,
-        };
-    }
+    let split = m >= SPLIT_MIN_CONTACTS;
     let h = &mut s.halves;
-    h.split(
-        positions,
-        domain,
-        Some(&mut contacts.iter().map(|c| c.i as usize)),
-    );
-    s.perm.extend_from_slice(&h.perm);
-    let n0 = h.n0;
+    if split {
+        h.split(
+            positions,
+            domain,
+            Some(&mut contacts.iter().map(|c| c.i as usize)),
+        );
+    }
+    let block = |i: usize, j: usize| if split { h.block(i, j) } else { 0 };
+    let n0 = if split { h.n0 } else { n };
     let mut counts = [0usize; 3];
     for b in 0..3u8 {
         for (k, c) in contacts.iter().enumerate() {
-            if h.block(c.i as usize, c.j as usize) != b {
-                continue;
+            if block(c.i as usize, c.j as usize) == b {
+                s.grouped.push(*c);
+                s.src.push(k as u32);
+                counts[b as usize] += 1;
             }
-            let shift = if b == 1 { n0 as u32 } else { 0 };
-            let mut g = *c;
-            g.i = h.local[c.i as usize] - shift;
-            if (c.j as usize) < n {
-                g.j = h.local[c.j as usize] - shift;
-            }
-            s.grouped.push(g);
-            s.src.push(k as u32);
-            counts[b as usize] += 1;
+        }
+    }
+    // local indices: first touch in blocks 0 and 1, then the rest of each half
+    s.local.clear();
+    s.local.resize(n, u32::MAX);
+    let mut next = [0u32, n0 as u32];
+    let side = |i: usize| if split { h.side[i] as usize } else { 0 };
+    let mut assign = |i: usize, local: &mut [u32]| {
+        if local[i] == u32::MAX {
+            local[i] = next[side(i)];
+            next[side(i)] += 1;
+        }
+    };
+    for c in &s.grouped[..counts[0] + counts[1]] {
+        assign(c.i as usize, &mut s.local);
+        if (c.j as usize) < n {
+            assign(c.j as usize, &mut s.local);
+        }
+    }
+    for i in 0..n {
+        assign(i, &mut s.local);
+    }
+    s.perm.clear();
+    s.perm.resize(n, 0);
+    for (i, &l) in s.local.iter().enumerate() {
+        s.perm[l as usize] = i as u32;
+    }
+    for (k, g) in s.grouped.iter_mut().enumerate() {
+        let shift = if k >= counts[0] && k < counts[0] + counts[1] {
+            n0 as u32
+        } else {
+            0
+        };
+        g.i = s.local[g.i as usize] - shift;
+        if (g.j as usize) < n {
+            g.j = s.local[g.j as usize] - shift;
         }
     }
     Blocks {

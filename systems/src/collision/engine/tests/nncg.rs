@@ -175,44 +175,88 @@ fn projection_travel_skip_is_bitwise_the_stamps_alone() {
     assert_eq!(sa, sb);
 }
 
+/// The blocked projection's momentum against its plain sweeps at the same budget: smaller
+/// overlaps after the projection (mean and largest per step) in fewer sweeps.
+#[test]
+fn projection_momentum_leaves_smaller_overlaps_than_plain_sweeps() {
+    let run = |no_momentum: bool| {
+        let mut engine = CollisionEngine::new(floored());
+        engine.proj.no_momentum = no_momentum;
+        forming_bed_with(1000, 10, engine, 300).0
+    };
+    let (a, b) = (run(true), run(false));
+    let over = |s: &CollisionStats| s.max_overlap_after_projection;
+    let sweeps = |s: &CollisionStats| s.projection_sweeps as f64;
+    let (oa, ob) = (mean_max(&a, over), mean_max(&b, over));
+    let (sa, sb) = (mean_max(&a, sweeps), mean_max(&b, sweeps));
+    println!("overlap after projection mean, max [d]: plain {oa:?}, momentum {ob:?}");
+    println!("projection sweeps mean, max: plain {sa:?}, momentum {sb:?}");
+    assert!(sa.1 > 3.0 && oa.0 > 0.0, "{sa:?} {oa:?}");
+    assert!(ob.0 < oa.0 && ob.1 < oa.1, "{ob:?} vs {oa:?}");
+    assert!(sb.0 < sa.0, "{sb:?} vs {sa:?}");
+}
+
 /// Per-step convergence of PGS at 50 sweeps against NNCG at several budgets on the forming bed
-/// (`cargo test --release -p magsep-systems --lib nncg_probe -- --ignored --nocapture`).
+/// (`cargo test --release -p magsep-systems --lib nncg_probe -- --ignored --nocapture`;
+/// `NNCG_BUDGETS=20,35` the resting budgets, `PROJ_BUDGETS=25,50` projection budgets with the
+/// floor (with and without the projection's momentum), `NNCG_BED=10000,32` spheres and floor cells, `NNCG_PGS=0` leaves out the reference).
 #[test]
 #[ignore = "probe: prints the convergence table"]
 fn nncg_probe() {
-    let budgets: Vec<u32> = std::env::var("NNCG_BUDGETS")
-        .ok()
-        .map(|v| v.split(',').filter_map(|x| x.parse().ok()).collect())
-        .unwrap_or_else(|| vec![20, 25, 30, 35, 40]);
+    let list = |key: &str| -> Option<Vec<u32>> {
+        std::env::var(key)
+            .ok()
+            .map(|v| v.split(',').filter_map(|x| x.parse().ok()).collect())
+    };
+    let budgets = list("NNCG_BUDGETS").unwrap_or_else(|| vec![20, 25, 30, 35, 40]);
+    let bed = list("NNCG_BED").unwrap_or_else(|| vec![1000, 10]);
+    let (n, cells) = (bed[0] as usize, bed[1] as usize);
     let steps = 300;
-    let mut cfgs = vec![
-        ("PGS 50".to_string(), pgs()),
-        ("NNCG 35, floor g h".to_string(), floored()),
-    ];
+    let mut cfgs = vec![];
+    if std::env::var("NNCG_PGS").as_deref() != Ok("0") {
+        cfgs.push(("PGS 50".to_string(), pgs(), false));
+    }
+    cfgs.push(("NNCG 35, floor g h".to_string(), floored(), false));
+    for k in list("PROJ_BUDGETS").unwrap_or_default() {
+        let cfg = EngineConfig {
+            projection_sweeps: k,
+            nncg_projection_sweeps: k,
+            ..floored()
+        };
+        cfgs.push((format!("floor, projection {k}"), cfg, false));
+        cfgs.push((format!("floor, projection {k} without momentum"), cfg, true));
+    }
     for k in budgets {
         let cfg = EngineConfig {
             nncg_sweeps: k,
             ..EngineConfig::default()
         };
-        cfgs.push((format!("NNCG {k}"), cfg));
+        cfgs.push((format!("NNCG {k}"), cfg, false));
     }
-    for (name, cfg) in cfgs {
+    for (name, cfg, no_momentum) in cfgs {
         let t = std::time::Instant::now();
-        let (st, s, _) = forming_bed(cfg, steps);
+        let mut engine = CollisionEngine::new(cfg);
+        engine.proj.no_momentum = no_momentum;
+        let (st, s, _) = forming_bed_with(n, cells, engine, steps);
         let wall = t.elapsed().as_secs_f64();
         let r = mean_max(&st, |s| s.resting_residual);
         let o = mean_max(&st, |s| s.max_overlap_after_projection);
         let sw = mean_max(&st, |s| s.resting_sweeps as f64);
+        let ps = mean_max(&st, |s| s.projection_sweeps as f64);
         let events: usize = st.iter().map(|s| s.events).sum();
         let contacts: usize = st.iter().map(|s| s.resting_contacts).sum();
         println!(
-            "{name}: residual {:.3e} / {:.3e} m/s, overlap {:.3e} / {:.3e} d, sweeps {:.1}, \
-             events {events}, contacts/step {:.0}, height {:.5} d, {wall:.2} s",
+            "{name}: residual {:.3e} / {:.3e} m/s, overlap {:.3e} / {:.3e} d, sweeps {:.1} / {:.0}, \
+             projection sweeps {:.1} / {:.0}, events {events}, contacts/step {:.0}, \
+             height {:.5} d, {wall:.2} s",
             r.0,
             r.1,
             o.0,
             o.1,
             sw.0,
+            sw.1,
+            ps.0,
+            ps.1,
             contacts as f64 / steps as f64,
             mean_height(&s)
         );
