@@ -429,11 +429,7 @@ pub fn integrate_brownian(
         && ws.hydro.is_none()
         && config.contact != ContactModel::HardCore;
     // `NetForce` beyond the model's forces (the fused step reads `NetForce` whole)
-    let mut extra = if fused {
-        Vec::new()
-    } else {
-        vec![DVec3::ZERO; n]
-    };
+    let mut extra = vec![DVec3::ZERO; if fused { 0 } else { n }];
     let mut net = Vec::new();
     if from_components {
         extra.resize(n, DVec3::ZERO);
