@@ -252,11 +252,15 @@ impl ForceModel {
         patches.ensure(x.len());
         if self.sources.is_empty() {
             // uniform field: a moment depends on the particle's law alone (and no field
-            // force), so consecutive particles of one law share one evaluation
+            // force), so consecutive particles of one law share one evaluation. Values
+            // already in place (the usual case: the last step's) are not written again: the
+            // other threads' pair passes read these arrays, and a write would take each cache
+            // line back from their caches
+            let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
             let mut last: Option<(MomentModel, DVec3)> = None;
             for (i, (m, f)) in moments.iter_mut().zip(field.iter_mut()).enumerate() {
                 let law = view.moments[i];
-                *m = match last {
+                let v = match last {
                     Some((l, v)) if l == law => v,
                     _ => {
                         let v = self.moment_and_field_force(x, view, i, &mut None).0;
@@ -264,7 +268,12 @@ impl ForceModel {
                         v
                     }
                 };
-                *f = DVec3::ZERO;
+                if bits(m) != bits(&v) {
+                    *m = v;
+                }
+                if bits(f) != bits(&DVec3::ZERO) {
+                    *f = DVec3::ZERO;
+                }
             }
             return;
         }
