@@ -70,6 +70,28 @@ pub struct CellList {
     /// Their positions, in the same order.
     sorted: Vec<DVec3>,
     index: Index,
+    /// Build scratch, kept for the next build: the binned particles, their cell keys, and
+    /// the counting sort's fill pointers.
+    members: Vec<u32>,
+    keys: Vec<usize>,
+    fill: Vec<u32>,
+}
+
+impl Default for CellList {
+    fn default() -> Self {
+        Self {
+            edge: 1.0,
+            reach: 1,
+            inv: 1.0,
+            origin: DVec3::ZERO,
+            order: Vec::new(),
+            sorted: Vec::new(),
+            index: Index::Sparse(CellMap::default()),
+            members: Vec::new(),
+            keys: Vec::new(),
+            fill: Vec::new(),
+        }
+    }
 }
 
 impl CellList {
@@ -91,7 +113,7 @@ impl CellList {
     /// cells.for_each_neighbour(&p, 0, 1.0, |j, _| near.push(j));
     /// assert_eq!(near, vec![1]);
     /// ```
-    pub fn build(positions: &[DVec3], edge: f64, include: impl Fn(usize) -> bool) -> Self {
+    pub fn build(positions: &[DVec3], edge: f64, include: impl Fn(usize) -> bool + Sync) -> Self {
         Self::build_with_reach(positions, edge, 1, include)
     }
 
@@ -102,14 +124,31 @@ impl CellList {
         positions: &[DVec3],
         cutoff: f64,
         reach: i64,
-        include: impl Fn(usize) -> bool,
+        include: impl Fn(usize) -> bool + Sync,
     ) -> Self {
+        let mut list = Self::default();
+        list.rebuild_with_reach(positions, cutoff, reach, include);
+        list
+    }
+
+    /// [`CellList::build_with_reach`] into this list, reusing its buffers (a list rebuilt at
+    /// every neighbour-list build allocates nothing once its buffers have grown).
+    pub fn rebuild_with_reach(
+        &mut self,
+        positions: &[DVec3],
+        cutoff: f64,
+        reach: i64,
+        include: impl Fn(usize) -> bool + Sync,
+    ) {
         let reach = reach.max(1);
         let edge = cutoff / reach as f64;
-        let members: Vec<u32> = (0..positions.len())
-            .filter(|&i| include(i) && positions[i].is_finite())
-            .map(|i| i as u32)
-            .collect();
+        let mut members = std::mem::take(&mut self.members);
+        members.clear();
+        members.extend(
+            (0..positions.len())
+                .filter(|&i| include(i) && positions[i].is_finite())
+                .map(|i| i as u32),
+        );
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for &i in &members {
             lo = lo.min(positions[i as usize]);
@@ -119,16 +158,8 @@ impl CellList {
             lo = DVec3::ZERO;
             hi = DVec3::ZERO;
         }
-        let mut list = Self {
-            edge,
-            reach,
-            inv: 1.0 / edge,
-            origin: lo,
-            order: Vec::new(),
-            sorted: Vec::new(),
-            index: Index::Sparse(CellMap::default()),
-        };
-        let span = ((hi - lo) * list.inv)
+        (self.edge, self.reach, self.inv, self.origin) = (edge, reach, 1.0 / edge, lo);
+        let span = ((hi - lo) * self.inv)
             .floor()
             .clamp(DVec3::ZERO, DVec3::splat(KEY_LIMIT));
         let cells = (span + DVec3::ONE).element_product();
@@ -140,37 +171,57 @@ impl CellList {
             [0; 3]
         };
         if !dense && reach > 1 {
-            return Self::build_with_reach(positions, cutoff, 1, include);
+            self.members = members;
+            return self.rebuild_with_reach(positions, cutoff, 1, include);
         }
+        let mut order = std::mem::take(&mut self.order);
+        order.clear();
         if dense {
             // counting sort into the grid (stable: particles by index within a cell)
             let n = (dims[0] * dims[1] * dims[2]) as usize;
             let flat = |k: [i64; 3]| ((k[2] * dims[1] + k[1]) * dims[0] + k[0]) as usize;
-            let key = |&i: &u32| flat(list.key(positions[i as usize]));
-            let keys: Vec<usize> = if members.len() < PAR_MIN {
-                members.iter().map(key).collect()
+            let mut keys = std::mem::take(&mut self.keys);
+            let mut fill = std::mem::take(&mut self.fill);
+            let mut starts =
+                match std::mem::replace(&mut self.index, Index::Sparse(CellMap::default())) {
+                    Index::Dense { starts, .. } => starts,
+                    Index::Sparse(_) => Vec::new(),
+                };
+            let this = &*self;
+            let key = |i: u32| flat(this.key(positions[i as usize]));
+            keys.clear();
+            keys.resize(members.len(), 0);
+            if members.len() < PAR_MIN {
+                keys.iter_mut()
+                    .zip(&members)
+                    .for_each(|(k, &i)| *k = key(i));
             } else {
-                members.par_iter().with_min_len(PAR_MIN).map(key).collect()
-            };
-            let mut starts = vec![0u32; n + 1];
+                keys.par_iter_mut()
+                    .zip(members.par_iter())
+                    .with_min_len(PAR_MIN)
+                    .for_each(|(k, &i)| *k = key(i));
+            }
+            starts.clear();
+            starts.resize(n + 1, 0);
             for &k in &keys {
                 starts[k + 1] += 1;
             }
             for c in 0..n {
                 starts[c + 1] += starts[c];
             }
-            let mut fill = starts.clone();
-            let mut order = vec![0u32; members.len()];
+            fill.clear();
+            fill.extend_from_slice(&starts[..n]);
+            order.resize(members.len(), 0);
             for (&i, &k) in members.iter().zip(&keys) {
                 order[fill[k] as usize] = i;
                 fill[k] += 1;
             }
-            list.order = order;
-            list.index = Index::Dense { dims, starts };
+            (self.keys, self.fill) = (keys, fill);
+            self.index = Index::Dense { dims, starts };
         } else {
             let mut keyed: Vec<([i64; 3], u32)> = members
                 .iter()
-                .map(|&i| (list.key(positions[i as usize]), i))
+                .map(|&i| (self.key(positions[i as usize]), i))
                 .collect();
             keyed.sort_unstable();
             let mut map = CellMap::with_capacity_and_hasher(keyed.len(), Default::default());
@@ -181,20 +232,23 @@ impl CellList {
                     start = k;
                 }
             }
-            list.order = keyed.into_iter().map(|(_, i)| i).collect();
-            list.index = Index::Sparse(map);
+            order.extend(keyed.into_iter().map(|(_, i)| i));
+            self.index = Index::Sparse(map);
         }
-        let at = |&i: &u32| positions[i as usize];
-        list.sorted = if list.order.len() < PAR_MIN {
-            list.order.iter().map(at).collect()
+        let mut sorted = std::mem::take(&mut self.sorted);
+        sorted.clear();
+        sorted.resize(order.len(), DVec3::ZERO);
+        let at = |(s, &i): (&mut DVec3, &u32)| *s = positions[i as usize];
+        if order.len() < PAR_MIN {
+            sorted.iter_mut().zip(&order).for_each(at);
         } else {
-            list.order
-                .par_iter()
+            sorted
+                .par_iter_mut()
+                .zip(order.par_iter())
                 .with_min_len(PAR_MIN)
-                .map(at)
-                .collect()
-        };
-        list
+                .for_each(at);
+        }
+        (self.members, self.order, self.sorted) = (members, order, sorted);
     }
 
     /// Largest cut-off the list serves \[m\] (cell edge × reach).
@@ -279,15 +333,21 @@ mod tests {
         for q in far.iter_mut().step_by(2) {
             *q += DVec3::splat(1e4);
         }
-        for (p, cutoff) in [(&p, 0.3), (&p, 1.0), (&p, 2.5), (&far, 1.0)] {
+        // one list rebuilt over every case (its buffers reused, dense after sparse too)
+        let mut reused = CellList::default();
+        for (p, cutoff) in [(&p, 0.3), (&p, 1.0), (&p, 2.5), (&far, 1.0), (&p, 2.5)] {
             let reach = if cutoff > 2.0 { 2 } else { 1 };
             let cells = CellList::build_with_reach(p, cutoff * 1.3, reach, skip);
+            reused.rebuild_with_reach(p, cutoff * 1.3, reach, skip);
             for i in 0..p.len() {
                 let mut got = vec![];
                 cells.for_each_neighbour(p, i, cutoff, |j, d| {
                     assert_eq!(d, p[i] - p[j]);
                     got.push(j)
                 });
+                let mut again = vec![];
+                reused.for_each_neighbour(p, i, cutoff, |j, _| again.push(j));
+                assert_eq!(again, got, "the same order, i = {i}");
                 got.sort();
                 let want: Vec<usize> = (0..p.len())
                     .filter(|&j| j != i && skip(j) && (p[i] - p[j]).length() < cutoff)

@@ -135,6 +135,39 @@ fn dipole_pair(cut: f64, d: DVec3, (ai, aj): (f64, f64), mi: DVec3, mj: DVec3) -
     }
 }
 
+/// The dipole force on `i` \[N\] gathered from the pair slots `pf` in its list order (a
+/// pair without a slot, from a particle that does not exert, computed here); zero unless `i`
+/// is mobile and magnetic.
+#[inline]
+fn dipole_gather(
+    cut: f64,
+    x: &[DVec3],
+    moments: &[DVec3],
+    view: &ParticleView,
+    list: &VerletList,
+    pf: &[DVec3],
+    i: usize,
+) -> DVec3 {
+    if !view.mobile[i] || moments[i] == DVec3::ZERO {
+        return DVec3::ZERO;
+    }
+    let mut sum = DVec3::ZERO;
+    for (j, s) in list.entries(i) {
+        sum += match pf.get(s as usize) {
+            Some(&p) if j > i => p,
+            Some(&p) => -p,
+            None => dipole_pair(
+                cut,
+                x[i] - x[j],
+                (view.radii[i], view.radii[j]),
+                moments[i],
+                moments[j],
+            ),
+        };
+    }
+    sum
+}
+
 /// Particles per chunk of the pair-force pass.
 const PAIR_CHUNK: usize = 256;
 
@@ -219,11 +252,15 @@ impl ForceModel {
         patches.ensure(x.len());
         if self.sources.is_empty() {
             // uniform field: a moment depends on the particle's law alone (and no field
-            // force), so consecutive particles of one law share one evaluation
+            // force), so consecutive particles of one law share one evaluation. Values
+            // already in place (the usual case: the last step's) are not written again: the
+            // other threads' pair passes read these arrays, and a write would take each cache
+            // line back from their caches
+            let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
             let mut last: Option<(MomentModel, DVec3)> = None;
             for (i, (m, f)) in moments.iter_mut().zip(field.iter_mut()).enumerate() {
                 let law = view.moments[i];
-                *m = match last {
+                let v = match last {
                     Some((l, v)) if l == law => v,
                     _ => {
                         let v = self.moment_and_field_force(x, view, i, &mut None).0;
@@ -231,7 +268,12 @@ impl ForceModel {
                         v
                     }
                 };
-                *f = DVec3::ZERO;
+                if bits(m) != bits(&v) {
+                    *m = v;
+                }
+                if bits(f) != bits(&DVec3::ZERO) {
+                    *f = DVec3::ZERO;
+                }
             }
             return;
         }
@@ -290,16 +332,65 @@ impl ForceModel {
             out.fill(DVec3::ZERO);
             return;
         };
-        let list = &lists.dipole;
-        let pair = |i: usize, j: usize, d: DVec3| {
-            dipole_pair(
-                cut,
-                d,
-                (view.radii[i], view.radii[j]),
-                moments[i],
-                moments[j],
-            )
+        let pf = self.dipole_pair_pass(cut, x, moments, view, lists);
+        par_fill(out, |i, f| {
+            *f = dipole_gather(cut, x, moments, view, &lists.dipole, &pf, i)
+        });
+        lists.pair_scratch.put(pf);
+    }
+
+    /// Dipole-dipole \[N\] and contact forces \[N\] on the mobile particles: the same values as
+    /// [`ForceModel::dipole_forces`] and [`ForceModel::contact_forces`], with both sums of a
+    /// particle in one parallel pass.
+    pub fn pair_forces(
+        &self,
+        x: &[DVec3],
+        moments: &[DVec3],
+        view: &ParticleView,
+        lists: &PairLists,
+        (dipole, contact): (&mut [DVec3], &mut [DVec3]),
+    ) {
+        let pf = self
+            .dipole_cutoff
+            .map(|cut| (cut, self.dipole_pair_pass(cut, x, moments, view, lists)));
+        let range = self.contact_range(view);
+        let go = |i: usize, (d, c): (&mut DVec3, &mut DVec3)| {
+            *d = match &pf {
+                Some((cut, pf)) => dipole_gather(*cut, x, moments, view, &lists.dipole, pf, i),
+                None => DVec3::ZERO,
+            };
+            *c = self.contact_force_on(x, view, lists, range, i);
         };
+        if dipole.len() < 512 {
+            dipole
+                .iter_mut()
+                .zip(contact.iter_mut())
+                .enumerate()
+                .for_each(|(i, o)| go(i, o));
+        } else {
+            dipole
+                .par_iter_mut()
+                .zip(contact.par_iter_mut())
+                .with_min_len(128)
+                .enumerate()
+                .for_each(|(i, o)| go(i, o));
+        }
+        if let Some((_, pf)) = pf {
+            lists.pair_scratch.put(pf);
+        }
+    }
+
+    /// The dipole force of each listed pair on its lower index, in its slot (the buffer
+    /// comes from `lists.pair_scratch`; give it back there).
+    fn dipole_pair_pass(
+        &self,
+        cut: f64,
+        x: &[DVec3],
+        moments: &[DVec3],
+        view: &ParticleView,
+        lists: &PairLists,
+    ) -> Vec<DVec3> {
+        let list = &lists.dipole;
         // each pair once (the force on its lower index), into its slot; chunks of particles
         // own consecutive slot ranges
         let n = x.len();
@@ -327,23 +418,7 @@ impl ForceModel {
             }
         });
         debug_assert_eq!(pf.len(), list.pair_count());
-        // gathered by both particles, each in its own list order
-        par_fill(out, |i, f| {
-            *f = DVec3::ZERO;
-            if !view.mobile[i] || moments[i] == DVec3::ZERO {
-                return;
-            }
-            let mut sum = DVec3::ZERO;
-            for (j, s) in list.entries(i) {
-                sum += match pf.get(s as usize) {
-                    Some(&p) if j > i => p,
-                    Some(&p) => -p,
-                    None => pair(i, j, x[i] - x[j]),
-                };
-            }
-            *f = sum;
-        });
-        lists.pair_scratch.put(pf);
+        pf
     }
 
     /// [`ForceModel::dipole_forces`] computed per particle over every neighbour, each pair
@@ -468,121 +543,12 @@ impl ForceModel {
         );
         self.update_lists(x, view, lists);
         let moments = std::mem::take(&mut parts.moments);
-        self.dipole_forces(x, &moments, view, lists, &mut parts.dipole);
+        let out = (parts.dipole.as_mut_slice(), parts.contact.as_mut_slice());
+        self.pair_forces(x, &moments, view, lists, out);
         parts.moments = moments;
-        self.contact_forces(x, view, lists, &mut parts.contact);
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{RngExt, SeedableRng};
-    use rand_xoshiro::Xoshiro256PlusPlus;
-
-    #[test]
-    fn the_pair_kernel_equals_the_direct_sums() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
-        let n = 900;
-        let x: Vec<DVec3> = (0..n)
-            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 4e-6)
-            .collect();
-        let radii: Vec<f64> = (0..n).map(|i| [75e-9, 100e-9, 50e-9][i % 3]).collect();
-        let moments: Vec<DVec3> = (0..n)
-            .map(|i| {
-                if i % 11 == 5 {
-                    DVec3::ZERO // non-magnetic
-                } else {
-                    DVec3::new(rng.random(), rng.random(), rng.random()) * 1e-16
-                }
-            })
-            .collect();
-        let laws = vec![MomentModel::default(); n];
-        let model = ForceModel {
-            sources: Vec::new(),
-            b_ext: DVec3::X,
-            tolerance: 1e-6,
-            kt: 4e-21,
-            mie: None,
-            dipole_cutoff: Some(12.0),
-            field_patch: None,
-        };
-        // captured particles that keep interacting, and ones that do not
-        let mobile: Vec<bool> = (0..n).map(|i| i % 7 != 2).collect();
-        // one `PairLists` for all three passes: the per-pair buffer is reused with another
-        // pair count each time (fewer pairs without the captured ones, then more again)
-        let mut lists = PairLists::default();
-        for interact in [true, false, true] {
-            let exerts: Vec<bool> = mobile.iter().map(|&m| m || interact).collect();
-            let view = ParticleView {
-                radii: &radii,
-                moments: &laws,
-                mobile: &mobile,
-                exerts: &exerts,
-            };
-            model.update_lists(&x, &view, &mut lists);
-            assert!(lists.dipole.pair_count() > 10 * n, "dense enough to test");
-            let (mut fast, mut direct) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-            model.dipole_forces(&x, &moments, &view, &lists, &mut fast);
-            model.dipole_forces_direct(&x, &moments, &view, &lists, &mut direct);
-            let scale = direct.iter().map(|f| f.length()).fold(0.0, f64::max);
-            assert!(scale > 0.0);
-            for i in 0..n {
-                assert!(
-                    (fast[i] - direct[i]).length() <= 1e-13 * scale,
-                    "{i}: {} {}",
-                    fast[i],
-                    direct[i]
-                );
-                if !mobile[i] {
-                    assert_eq!(fast[i], DVec3::ZERO);
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn cached_lists_give_the_forces_of_fresh_lists_bit_for_bit() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
-        let n = 600;
-        let a = 75e-9;
-        let mut x: Vec<DVec3> = (0..n)
-            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 3e-6)
-            .collect();
-        let model = ForceModel {
-            sources: Vec::new(),
-            b_ext: DVec3::new(0.3, 0.0, 1.0),
-            tolerance: 1e-6,
-            kt: 4e-21,
-            mie: Some(Mie::new(4e-19, 30.0, 15.0)),
-            dipole_cutoff: Some(10.0),
-            field_patch: None,
-        };
-        let laws = vec![MomentModel::Saturated { moment: 1e-16 }; n];
-        let (radii, mobile) = (vec![a; n], vec![true; n]);
-        let view = ParticleView {
-            radii: &radii,
-            moments: &laws,
-            mobile: &mobile,
-            exerts: &mobile,
-        };
-        let (mut cached, mut fresh) = (PairLists::default(), PairLists::default());
-        fresh.set_rebuild_always(true);
-        let (mut pc, mut pf) = (ForceParts::zeros(n), ForceParts::zeros(n));
-        for _ in 0..40 {
-            model.evaluate(&x, &view, &mut cached, &mut pc);
-            model.evaluate(&x, &view, &mut fresh, &mut pf);
-            assert_eq!(pc, pf);
-            for p in x.iter_mut() {
-                *p += DVec3::new(rng.random(), rng.random(), rng.random()) * 8e-9 - 4e-9;
-            }
-        }
-        assert!(pc.dipole.iter().any(|f| *f != DVec3::ZERO));
-        assert!(
-            cached.builds() > 2 && cached.builds() < 40,
-            "{}",
-            cached.builds()
-        );
-        assert_eq!(fresh.builds(), 80);
-    }
-}
+#[path = "model_tests.rs"]
+mod tests;

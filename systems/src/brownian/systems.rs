@@ -298,10 +298,13 @@ pub fn prepare_brownian_step(
     );
     d.resize(n, DVec3::ZERO);
     c.resize(n, DVec3::ZERO);
-    ws.model
-        .dipole_forces(&ws.positions, &ws.moments, &view, &ws.lists, &mut d);
-    ws.model
-        .contact_forces(&ws.positions, &view, &ws.lists, &mut c);
+    ws.model.pair_forces(
+        &ws.positions,
+        &ws.moments,
+        &view,
+        &ws.lists,
+        (&mut d, &mut c),
+    );
     (ws.dipole, ws.contact) = (d, c);
 }
 
@@ -421,10 +424,15 @@ pub fn integrate_brownian(
 ) {
     let ws = &mut *ws;
     let n = ws.positions.len();
-    let mut extra = vec![DVec3::ZERO; n];
     let from_components = force_components_written(wanted, registry);
+    let fused = config.step_control == StepControl::Fixed
+        && ws.hydro.is_none()
+        && config.contact != ContactModel::HardCore;
+    // `NetForce` beyond the model's forces (the fused step reads `NetForce` whole)
+    let mut extra = vec![DVec3::ZERO; if fused { 0 } else { n }];
     let mut net = Vec::new();
     if from_components {
+        extra.resize(n, DVec3::ZERO);
         net = vec![DVec3::ZERO; n];
         read_net_force(&ws.entities, &forces, &mut net, &mut extra);
     }
@@ -460,9 +468,6 @@ pub fn integrate_brownian(
         failure: None,
     };
     let mut x = std::mem::take(&mut ws.positions);
-    let fused = config.step_control == StepControl::Fixed
-        && dynamics.hydro.is_none()
-        && !dynamics.hard_core;
     if fused {
         if from_components {
             dynamics.fixed_free_step(&mut x, |k| net[k], clock.dt, &mut ws.rngs, &mut stats);

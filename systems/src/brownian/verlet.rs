@@ -37,6 +37,11 @@ use super::cells::CellList;
 /// Particles per build chunk (fixed: the list does not depend on the thread count).
 const CHUNK: usize = 256;
 
+/// Fewest particles for which the per-evaluation displacement check runs in parallel: below,
+/// it takes a few tens of µs on one thread, less than waking the pool's other threads for it
+/// (a parallel region per check and list, two per step, each paid in wake-ups).
+const SERVES_PAR_MIN: usize = 1 << 16;
+
 /// A list rebuilt after serving fewer evaluations than this doubles its skin.
 pub const SKIN_GROW_BELOW: u64 = 4;
 /// A list rebuilt after serving more evaluations than this halves its skin (not below the
@@ -81,6 +86,19 @@ pub struct VerletList {
     /// The list built before this one, kept for a configuration it still serves (see
     /// [`VerletList::ensure`]); its own `spare` is always `None`.
     spare: Option<Box<VerletList>>,
+    /// Build scratch kept for the next build (cell list and per-chunk neighbour runs): a
+    /// build allocates nothing once they have grown, so it pays no page faults.
+    cells: CellList,
+    scratch: Vec<ChunkScratch>,
+}
+
+/// One build chunk's particles: their neighbours (each particle's run sorted), run lengths,
+/// and the offset of the first neighbour `j > i` in each run.
+#[derive(Debug, Clone, Default)]
+struct ChunkScratch {
+    js: Vec<u32>,
+    counts: Vec<u32>,
+    ups: Vec<u32>,
 }
 
 /// A buffer reused across evaluations through a shared reference: the dipole sum's per-pair
@@ -142,12 +160,12 @@ impl VerletList {
         // NaN displacements fail the test, so a broken configuration is rebinned (and its
         // non-finite particles dropped by the cell list)
         let within = |(p, q): (&DVec3, &DVec3)| (*p - *q).length_squared() <= limit;
-        if x.len() < 4 * CHUNK {
+        if x.len() < SERVES_PAR_MIN {
             x.iter().zip(&self.reference).all(within)
         } else {
             x.par_iter()
                 .zip(self.reference.par_iter())
-                .with_min_len(4 * CHUNK)
+                .with_min_len(SERVES_PAR_MIN / 2)
                 .all(within)
         }
     }
@@ -197,35 +215,95 @@ impl VerletList {
 
     fn build(&mut self, x: &[DVec3], exerts: &[bool], range: f64, skin: f64) {
         let reach_range = range + skin;
-        let cells = CellList::build_with_reach(x, reach_range, 2, |j| exerts[j]);
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let (a, b) = (c * CHUNK, ((c + 1) * CHUNK).min(x.len()));
-                let mut counts = Vec::with_capacity(b - a);
-                let mut js = Vec::new();
-                for i in a..b {
-                    let before = js.len();
-                    if x[i].is_finite() {
-                        cells.for_each_neighbour(x, i, reach_range, |j, _| js.push(j as u32));
-                    }
-                    js[before..].sort_unstable();
-                    counts.push((js.len() - before) as u32);
+        let mut cells = std::mem::take(&mut self.cells);
+        cells.rebuild_with_reach(x, reach_range, 2, |j| exerts[j]);
+        let n = x.len();
+        // each chunk's particles: their sorted neighbours, counts and first entry j > i
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.resize_with(n.div_ceil(CHUNK), ChunkScratch::default);
+        scratch.par_iter_mut().enumerate().for_each(|(c, s)| {
+            let (a, b) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+            s.counts.clear();
+            s.ups.clear();
+            s.js.clear();
+            for i in a..b {
+                let before = s.js.len();
+                if x[i].is_finite() {
+                    cells.for_each_neighbour(x, i, reach_range, |j, _| s.js.push(j as u32));
                 }
-                (counts, js)
-            })
-            .collect();
+                let own = &mut s.js[before..];
+                own.sort_unstable();
+                s.ups
+                    .push(own.partition_point(|&j| (j as usize) < i) as u32);
+                s.counts.push(own.len() as u32);
+            }
+        });
+        self.cells = cells;
+        // offsets (serial sums over the particles)
         self.starts.clear();
         self.starts.push(0);
-        self.neighbours.clear();
-        for (counts, js) in chunks {
-            for c in counts {
-                let last = *self.starts.last().unwrap_or(&0);
-                self.starts.push(last + c);
+        self.upper.clear();
+        self.pair_base.clear();
+        self.pair_base.push(0);
+        let (mut entries, mut pairs) = (0u32, 0u32);
+        for (c, s) in scratch.iter().enumerate() {
+            for (k, (&count, &up)) in s.counts.iter().zip(&s.ups).enumerate() {
+                entries += count;
+                self.starts.push(entries);
+                self.upper.push(up);
+                if exerts.get(c * CHUNK + k).copied().unwrap_or(false) {
+                    pairs += count - up;
+                }
+                self.pair_base.push(pairs);
             }
-            self.neighbours.extend_from_slice(&js);
         }
-        self.number_pairs(exerts);
+        // each chunk's entries and slots straight into their place (in parallel: the list is
+        // the same for any split)
+        let total = entries as usize;
+        self.neighbours.resize(total, 0);
+        self.slots.resize(total, 0);
+        let mut parts: Vec<(usize, &mut [u32], &mut [u32])> = Vec::with_capacity(scratch.len());
+        let (mut nb, mut sl) = (self.neighbours.as_mut_slice(), self.slots.as_mut_slice());
+        for (c, s) in scratch.iter().enumerate() {
+            let (head, tail) = std::mem::take(&mut nb).split_at_mut(s.js.len());
+            let (shead, stail) = std::mem::take(&mut sl).split_at_mut(s.js.len());
+            parts.push((c, head, shead));
+            (nb, sl) = (tail, stail);
+        }
+        let (starts, upper, pair_base) = (&self.starts, &self.upper, &self.pair_base);
+        let scratch_ref = &scratch;
+        // neighbour list of particle j, read from its chunk's scratch
+        let list_of = |j: usize| -> &[u32] {
+            let s = &scratch_ref[j / CHUNK];
+            let first = starts[j / CHUNK * CHUNK];
+            &s.js[(starts[j] - first) as usize..(starts[j + 1] - first) as usize]
+        };
+        parts.into_par_iter().for_each(|(c, nb, sl)| {
+            let s = &scratch_ref[c];
+            nb.copy_from_slice(&s.js);
+            let (a, b) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+            let mut e = 0;
+            for i in a..b {
+                let exerting = exerts.get(i).copied().unwrap_or(false);
+                let own = list_of(i);
+                for (k, &j) in own.iter().enumerate() {
+                    let j = j as usize;
+                    sl[e] = if !exerting {
+                        NO_SLOT
+                    } else if j > i {
+                        pair_base[i] + (k as u32 - upper[i])
+                    } else {
+                        // i is in j's list (both exert, the test is symmetric)
+                        match list_of(j).binary_search(&(i as u32)) {
+                            Ok(pos) => pair_base[j] + (pos as u32 - upper[j]),
+                            Err(_) => NO_SLOT,
+                        }
+                    };
+                    e += 1;
+                }
+            }
+        });
+        self.scratch = scratch;
         self.reference.clear();
         self.reference.extend_from_slice(x);
         self.exerts.clear();
@@ -233,54 +311,6 @@ impl VerletList {
         self.range = range;
         self.skin = skin;
         self.builds += 1;
-    }
-
-    /// Slots of the pairs: `i` owns its entries `j > i` when it exerts; an entry `j < i` finds
-    /// its slot in `j`'s (ascending) list by bisection.
-    fn number_pairs(&mut self, exerts: &[bool]) {
-        let n = self.starts.len() - 1;
-        self.upper.clear();
-        self.pair_base.clear();
-        self.pair_base.push(0);
-        for (i, &exerting) in exerts.iter().enumerate().take(n) {
-            let own = &self.neighbours[self.starts[i] as usize..self.starts[i + 1] as usize];
-            let up = own.partition_point(|&j| (j as usize) < i);
-            self.upper.push(up as u32);
-            let owned = if exerting { own.len() - up } else { 0 };
-            let last = *self.pair_base.last().unwrap_or(&0);
-            self.pair_base.push(last + owned as u32);
-        }
-        let this = &*self;
-        let slots: Vec<Vec<u32>> = (0..n.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let mut out = Vec::new();
-                let end = ((c + 1) * CHUNK).min(n);
-                for (i, &exerting) in exerts.iter().enumerate().take(end).skip(c * CHUNK) {
-                    let (a, b) = (this.starts[i] as usize, this.starts[i + 1] as usize);
-                    for (k, &j) in this.neighbours[a..b].iter().enumerate() {
-                        let j = j as usize;
-                        out.push(if !exerting {
-                            NO_SLOT
-                        } else if j > i {
-                            this.pair_base[i] + (k as u32 - this.upper[i])
-                        } else {
-                            // i is in j's list (both exert, the test is symmetric)
-                            let (ja, jb) = (this.starts[j] as usize, this.starts[j + 1] as usize);
-                            match this.neighbours[ja..jb].binary_search(&(i as u32)) {
-                                Ok(pos) => this.pair_base[j] + (pos as u32 - this.upper[j]),
-                                Err(_) => NO_SLOT,
-                            }
-                        });
-                    }
-                }
-                out
-            })
-            .collect();
-        self.slots.clear();
-        for s in slots {
-            self.slots.extend_from_slice(&s);
-        }
     }
 
     /// Number of pair slots.
