@@ -155,6 +155,6 @@ pub fn overlap_upper_bound(
         return f64::INFINITY;
     };
     let (ua, ub) = (qa.conjugate() * u, qb.conjugate() * -u);
-    let bound = ua.dot(a.prepared.support(ua)) + ub.dot(b.prepared.support(ub)) - d.dot(u);
+    let bound = a.prepared.support_value(ua) + b.prepared.support_value(ub) - d.dot(u);
     if bound.is_nan() { f64::INFINITY } else { bound }
 }
