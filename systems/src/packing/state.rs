@@ -16,7 +16,11 @@ use magsep_components::shape::Shape;
 pub use super::body::{Body, BodyKind};
 use super::contact::{PairContact, pair_contact, superquadric_contact};
 use super::walls::{self, WallContact, WallKind};
-use crate::geometry::superquadric::WarmStart;
+use crate::geometry::superquadric::{WarmStart, overlap_upper_bound};
+
+/// Round-off margin / D of [`PackingState::contact_warm_above`]'s bound test (the bound's own
+/// error is ~1e-15 D, the solver's ~1e-13 D).
+const BOUND_MARGIN: f64 = 1e-10;
 
 /// Positions, orientations and bodies of all particles in a container, reduced units.
 #[derive(Debug, Clone, PartialEq)]
@@ -153,6 +157,39 @@ impl PackingState {
             self.orientations[j],
             warm,
         )
+    }
+
+    /// [`Self::contact_warm`] if the pair overlaps by more than `tol`, else None. A
+    /// superquadric pair whose overlap is certainly at most `tol` (its separating-axis bound
+    /// along the cached contact normal, [`overlap_upper_bound`], below `tol` less a round-off
+    /// margin) is not solved and keeps its cached Newton start: its solved overlap would be
+    /// below `tol` too (to the solver's accuracy, ~1e-13 D, far inside the margin).
+    #[inline]
+    pub fn contact_warm_above(
+        &self,
+        i: usize,
+        j: usize,
+        shift: DVec3,
+        warm: &mut Option<WarmStart>,
+        tol: f64,
+    ) -> Option<PairContact> {
+        let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
+        if self.is_superquadric_pair(i, j) {
+            let bound = overlap_upper_bound(
+                &bi.contact_shape,
+                self.positions[i],
+                self.orientations[i],
+                &bj.contact_shape,
+                self.positions[j] + shift,
+                self.orientations[j],
+                warm.as_ref(),
+            );
+            if bound <= tol - BOUND_MARGIN {
+                return None;
+            }
+        }
+        let c = self.contact_warm(i, j, shift, warm);
+        (c.overlap > tol).then_some(c)
     }
 
     /// Wall contacts of particle `i` with overlap > `-margin` (virtual rods for spheres and

@@ -214,7 +214,7 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
     let mut tracker = OverlapTracker::new();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
     let mut flags = Vec::new();
-    let (mut hits, mut compared_after_moves) = (0, 0);
+    let (mut hits, mut compared_after_moves, mut below) = (0, 0, 0);
     for round in 0..4 {
         list.ensure(&mut state);
         pool(2).install(|| tracker.scan(&state, &mut list, tol, &mut flags));
@@ -229,6 +229,12 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
                 compared_after_moves += usize::from(round > 0);
                 let mut warm = None; // a cold solve: GJK/EPA seed, then Newton
                 let f = state.contact_warm(i, nb.j as usize, nb.shift(state.edges), &mut warm);
+                let Some(c) = c else {
+                    // not solved: certainly at most the tolerance
+                    below += 1;
+                    assert!(f.overlap <= tol, "{f:?}");
+                    continue;
+                };
                 assert!((c.overlap - f.overlap).abs() < 1e-10, "{c:?} {f:?}");
                 if f.overlap > -0.02 {
                     assert!((c.normal - f.normal).length() < 1e-6, "{c:?} {f:?}");
@@ -272,7 +278,7 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
         }
     }
     assert!(
-        hits > 500 && compared_after_moves > 100,
-        "{hits} {compared_after_moves}"
+        hits > 500 && compared_after_moves > 100 && below > 50,
+        "{hits} {compared_after_moves} {below}"
     );
 }
