@@ -107,7 +107,7 @@ pub fn brownian_force_use(control: &StepControl) -> ForceUse {
         StepControl::Adaptive { .. } | StepControl::Multirate { .. } => Consumption::Refused(
             "the brownian pipeline's adaptive stepper re-evaluates forces at every sub-step, \
              and a ForceContribution component is a value computed once per step (it would \
-             be frozen over the sub-steps); implement `magsep_systems::forces::ExternalForce` \
+             be frozen over the sub-steps); implement `magsep::systems::forces::ExternalForce` \
              and register it with `SimApp::add_external_force` instead, or use \
              step_control = fixed"
                 .into(),

@@ -90,7 +90,7 @@ pub fn packing_force_use(scheme: OverlapRemovalScheme) -> ForceUse {
         builtin: Vec::new(),
         contributions: Consumption::Refused(
             "the packing pipeline moves particles by geometric rules and never reads \
-             NetForce; implement `magsep_systems::forces::ExternalForce` and register it \
+             NetForce; implement `magsep::systems::forces::ExternalForce` and register it \
              with `SimApp::add_external_force` (acts with scheme = \"fire\")"
                 .into(),
         ),

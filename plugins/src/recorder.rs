@@ -34,7 +34,8 @@ use crate::record::{ParticleFrame, RecordingWriter};
 #[derive(Resource, Default)]
 pub struct Recorder {
     /// The writer, if recording. Plugins may add channels to it and write their messages
-    /// (see `RecordingWriter::add_channel`).
+    /// (see `RecordingWriter::add_channel`), best from a [`FrameWriter`] so that the channel
+    /// has a message for every frame.
     pub writer: Option<RecordingWriter>,
     /// Record every this many steps (>= 1).
     pub every: u64,
@@ -45,11 +46,17 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Report a write error: the first one is kept, the writer is dropped (closing the file
-    /// best-effort) and nothing more is recorded; the driver stops the run after this step.
+    /// Report a write error: the first one is kept, the file is marked interrupted with it
+    /// (best effort), the writer is dropped (closing the file best-effort) and nothing more is
+    /// recorded; the driver stops the run after this step.
     pub fn fail(&mut self, error: impl Into<String>) {
+        let error = error.into();
+        if let Some(w) = self.writer.as_mut() {
+            // best effort (a full disk refuses it too): the file then says why it ends early
+            let _ = w.write_interrupted(&format!("recording error: {error}"));
+        }
         if self.error.is_none() {
-            self.error = Some(error.into());
+            self.error = Some(error);
         }
         self.writer = None;
     }

@@ -264,4 +264,16 @@ fn a_plugin_channel_has_one_message_per_frame_step_0_final_and_interrupted_inclu
     );
     assert_eq!(err.partial_summary().unwrap()["steps"], 60);
     assert_eq!(step_messages(&path), [0, 30]);
+    // and the file says why it ends early
+    let rec = read_recording(&path).unwrap();
+    let why = rec
+        .metadata_records
+        .iter()
+        .find(|m| m.name == magsep::plugins::record::INTERRUPTED_METADATA_NAME)
+        .expect("interrupted record");
+    assert!(
+        why.entries["reason"].contains("/test/step at step 60"),
+        "{:?}",
+        why.entries
+    );
 }
