@@ -154,6 +154,20 @@ fn plugins_register_new_scene_kinds() {
     );
     let e = parse_scene(&format!("{GOOD}\n[magnets]\nstrength = -1.0\n"), &reg).unwrap_err();
     assert_eq!(e.0[0].path, "magnets.strength");
+    // without the kind: an unknown key, with a hint for a table (a plugin's section)
+    let e = parse_scene(
+        &format!("{GOOD}\n[magnets]\nstrength = 1.5\n"),
+        &Registry::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.0[0].path, "magnets");
+    assert!(
+        e.0[0].message.contains("built with that plugin"),
+        "{}",
+        e.0[0]
+    );
+    let e = parse_scene(&format!("magnets = 1.5\n{GOOD}"), &Registry::default()).unwrap_err();
+    assert!(!e.0[0].message.contains("plugin"), "{}", e.0[0]);
 }
 
 #[test]

@@ -363,9 +363,16 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
                             None => keys.push("the sections of the [simulation] pipeline".into()),
                         }
                         keys.extend(registry.kind_keys());
+                        // a table may be a plugin's section this program was not built with
+                        let hint = if value.is_table() {
+                            "; a plugin's section is read only by a program built with that \
+                             plugin (its kind registered through magsep::cli::Extensions)"
+                        } else {
+                            ""
+                        };
                         errors.push(SceneError::new(
                             other,
-                            format!("unknown key; expected one of {}", keys.join(", ")),
+                            format!("unknown key; expected one of {}{hint}", keys.join(", ")),
                         ));
                     } else {
                         errors.push(SceneError::new(other, only_for(&owned)));
