@@ -90,7 +90,8 @@ fn pretty(v: &serde_json::Value) -> String {
 }
 
 /// `magsep validate SWEEP.toml`: the sweep file and every point's scene, each point within the
-/// memory budget alone (exit 2 with the failing points' key paths otherwise).
+/// memory budget alone and spawned with its schedule built (exit 2 with the failing points'
+/// key paths or refusals otherwise).
 pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Result<(), CliError> {
     let budget = crate::scene::memory::budget(budget_gib).map_err(CliError::input)?;
     let (sweep, memory) = sweep::load_checked(path, &ext.registry).map_err(to_cli)?;
@@ -102,6 +103,20 @@ pub fn validate(ext: &Extensions, path: &Path, budget_gib: Option<f64>) -> Resul
                 path.display()
             ))
         })?;
+    // spawn every point and build its schedule, as `magsep validate SCENE` does, so what a
+    // run would refuse before its first step fails here
+    let progress = StderrProgress::new(false, "points");
+    progress.bar().set_length(all.len() as u64);
+    let built = sweep::run::build_points(&sweep, &ext.registry, &ext.plugins, &all, &|| {
+        progress.bar().inc(1)
+    });
+    drop(progress);
+    built.map_err(|e| {
+        CliError::input(format!(
+            "{}: a point's scene is refused before its first step:\n{e}",
+            path.display()
+        ))
+    })?;
     print(pretty(&serde_json::json!({
         "valid": true,
         "sweep": path.display().to_string(),

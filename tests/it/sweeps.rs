@@ -431,6 +431,15 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
         row.contains(",error,") && row.contains("start region"),
         "{row}"
     );
+    // `magsep validate` spawns every point, so it finds that point before anything runs
+    let v = magsep(&["validate", &sweep]);
+    assert_eq!(v.status.code(), Some(2), "{}", stderr(&v));
+    let e = stderr(&v);
+    assert!(
+        e.contains("point 1 (particles[0].count=20000") && e.contains("start region"),
+        "{e}"
+    );
+    assert!(!e.contains("point 0 "), "{e}");
 }
 
 #[test]

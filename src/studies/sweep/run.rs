@@ -15,7 +15,7 @@ use toml_edit::DocumentMut;
 use super::file::{Point, Sweep, value_cell};
 use crate::scene::overrides::{apply_to_document, parse_document};
 use crate::scene::{NoProgress, Registry, RunOptions, Scene, SceneErrors, parse_scene};
-use crate::sim::{SimError, run_scene};
+use crate::sim::{SimError, Simulation, run_scene};
 
 /// Name of the manifest in a sweep directory.
 pub const MANIFEST: &str = "sweep.json";
@@ -106,6 +106,59 @@ pub fn check_points(
     }
     if count == 0 {
         return Ok(estimates);
+    }
+    let more = if count > failing.len() {
+        format!("\n... and {} more points", count - failing.len())
+    } else {
+        String::new()
+    };
+    Err(format!("{}{more}", failing.join("\n")))
+}
+
+/// Spawn the scene of every point of `indices` and build its schedule with `plugins`,
+/// stepping nothing and recording nothing: what a run would refuse before its first step (a
+/// start region too small for its particles, a plugin's force the integrator cannot use) is
+/// found before the sweep runs. `tick` is called after each point.
+///
+/// # Errors
+/// The failing points (up to ten listed), each with its overrides and the refusal.
+pub fn build_points(
+    sweep: &Sweep,
+    registry: &Registry,
+    plugins: &[Arc<dyn SimPlugin>],
+    indices: &[usize],
+    tick: &dyn Fn(),
+) -> Result<(), String> {
+    let base = base_document(sweep).map_err(|e| format!("scene: {e}"))?;
+    let mut failing = Vec::new();
+    let mut count = 0;
+    for &i in indices {
+        let point = sweep.point(i);
+        let built = point_scene(sweep, &base, &point, registry)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| {
+                if scene.pipeline.is_none() {
+                    return Ok(());
+                }
+                let options = RunOptions {
+                    single_threaded: true,
+                    plugins: plugins.to_vec(),
+                    ..Default::default()
+                };
+                Simulation::from_scene(&scene, options)
+                    .map(drop)
+                    .map_err(|e| e.to_string())
+            });
+        if let Err(e) = built {
+            count += 1;
+            if failing.len() < MAX_LISTED {
+                failing.push(format!("point {i} ({}): {e}", point_overrides(sweep, i)));
+            }
+        }
+        tick();
+    }
+    if count == 0 {
+        return Ok(());
     }
     let more = if count > failing.len() {
         format!("\n... and {} more points", count - failing.len())
