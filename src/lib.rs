@@ -18,6 +18,7 @@ pub mod cli;
 pub mod error;
 pub mod fieldtool;
 pub mod input;
+pub mod names;
 pub mod pipelines;
 pub mod replay;
 pub mod scene;

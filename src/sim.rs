@@ -14,10 +14,11 @@ use magsep_plugins::record::{
     FibreShape, FrameBuffering, PluginInfo, RecordingMetadata, RecordingWriter,
 };
 use magsep_plugins::recorder::{Recorder, record_now, recording_error};
-use magsep_systems::forces::ForceComponents;
+use magsep_systems::forces::{ExternalForces, ForceComponents, ForceRegistry};
 use serde_json::Value;
 
 pub use crate::error::SimError;
+use crate::names::short_name;
 pub use crate::scene::pipeline::StopFlag;
 pub use crate::scene::{ExecutorChoice, RunOptions};
 use crate::scene::{NoProgress, Pipeline, Progress, RecordEvery, RunInfo, Scene, spawn_scene};
@@ -275,6 +276,9 @@ impl Simulation {
             wall_time_s: self.started.elapsed().as_secs_f64(),
         };
         let mut summary = self.pipeline.summary(&self.app.world, &run);
+        if let Value::Object(map) = &mut summary {
+            force_keys(&self.app.world, map);
+        }
         if let (Some(extra), Value::Object(map)) =
             (self.app.world.get_resource::<SummaryExtras>(), &mut summary)
         {
@@ -478,4 +482,22 @@ fn run_steps(
 pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<Value, String> {
     let scene = crate::scene::load_scene(path, &Default::default()).map_err(|e| e.to_string())?;
     run_scene(&scene, &options, &NoProgress).map_err(|e| e.to_string())
+}
+
+/// The summary's `force_contributions` (every registered contribution in summation order, the
+/// pipeline's and the plugins', type names without paths) and `force_kernels` (the registered
+/// external force kernels' names), so a run's summary says which forces acted on it; a key is
+/// left out when nothing is registered, and a key the pipeline set is kept.
+pub(crate) fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>) {
+    if let Some(reg) = world.get_resource::<ForceRegistry>()
+        && !reg.names.is_empty()
+    {
+        let names: Vec<String> = reg.names.iter().map(|n| short_name(n)).collect();
+        map.entry("force_contributions").or_insert(names.into());
+    }
+    if let Some(k) = world.get_resource::<ExternalForces>()
+        && !k.is_empty()
+    {
+        map.entry("force_kernels").or_insert(k.names().into());
+    }
 }

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use crate::input::named_inputs;
+use crate::names::short_name;
 use crate::plugins::record::{
     ChannelInfo, ReadMode, ReaderLimits, RecordError, RecordingMetadata, RecordingReader,
     trailing_message,
@@ -236,41 +237,18 @@ fn schedule_lines(m: &RecordingMetadata) -> Vec<String> {
     };
     let mut sets: Vec<_> = m.schedule.iter().collect();
     sets.sort_by_key(|(s, _)| (rank(s), s.to_string()));
+    // one column for the names, as wide as the longest set name
+    let width = sets
+        .iter()
+        .map(|(s, _)| s.chars().count())
+        .max()
+        .unwrap_or(0);
     sets.into_iter()
         .map(|(set, systems)| {
             let short: Vec<String> = systems.iter().map(|s| short_name(s)).collect();
-            format!("  {set:<12} {}", short.join(", "))
+            format!("  {set:<width$} {}", short.join(", "))
         })
         .collect()
-}
-
-/// A system's name without module paths, also inside generics:
-/// `a::clear_contribution<b::PullForce>` gives `clear_contribution<PullForce>`.
-fn short_name(name: &str) -> String {
-    let mut out = String::with_capacity(name.len());
-    let mut ident = String::new();
-    for c in name.chars() {
-        match c {
-            ':' => ident.clear(),
-            c if c.is_alphanumeric() || c == '_' => ident.push(c),
-            c => {
-                out.push_str(&ident);
-                ident.clear();
-                out.push(c);
-            }
-        }
-    }
-    out + &ident
-}
-
-#[test]
-fn system_names_lose_their_paths_inside_generics_too() {
-    assert_eq!(
-        short_name("magsep_systems::forces::clear_contribution<myext::pull::PullForce>"),
-        "clear_contribution<PullForce>"
-    );
-    assert_eq!(short_name("advance_clock"), "advance_clock");
-    assert_eq!(short_name("a::f<b::X, c::Y<d::Z>>"), "f<X, Y<Z>>");
 }
 
 /// `magsep replay`: the summary of the recording's complete frames; a damaged file is

@@ -112,3 +112,65 @@ fn two_spheres_settle_with_the_rpy_closed_forms() {
         assert!((v[0].z + stokes).abs() < 1e-6 * stokes);
     }
 }
+
+/// Uniform force kernel along -z \[N\].
+struct Weight;
+
+impl magsep::systems::forces::ExternalForce for Weight {
+    fn force_torque(&self, _p: &magsep::systems::forces::ParticleState) -> (DVec3, DVec3) {
+        (DVec3::new(0.0, 0.0, -F0), DVec3::ZERO)
+    }
+}
+
+#[derive(Clone, Copy)]
+struct WeightPlugin;
+
+impl SimPlugin for WeightPlugin {
+    fn build(&self, app: &mut SimApp) {
+        app.add_external_force("weight", std::sync::Arc::new(Weight));
+    }
+}
+
+#[test]
+fn the_run_summary_names_every_force_a_plugin_added() {
+    let text = r#"
+[simulation]
+pipeline = "brownian"
+[brownian]
+time_step = 1e-5
+duration = 3e-5
+temperature = 300
+step_control = { kind = "fixed" }
+[[particles]]
+count = 2
+shape = { kind = "sphere", radius = 1e-7 }
+placement = { kind = "points", positions = [[0.0, 0.0, 0.0], [1e-6, 0.0, 0.0]] }
+"#;
+    let scene = parse_scene(text, &Default::default()).unwrap();
+    let summary = |pipeline| {
+        let options = RunOptions {
+            pipeline: Some(pipeline),
+            ..Default::default()
+        };
+        let mut sim = Simulation::from_scene(&scene, options).unwrap();
+        sim.run(|_| {}).unwrap()
+    };
+    let plain = summary(brownian_pipeline());
+    assert_eq!(
+        plain["force_contributions"],
+        serde_json::json!(["FieldForce", "DipoleForce", "ContactForce"])
+    );
+    assert!(plain.get("force_kernels").is_none(), "{plain}");
+    let pushed = summary(brownian_pipeline().add(PushPlugin).add(WeightPlugin));
+    assert_eq!(
+        pushed["force_contributions"],
+        serde_json::json!([
+            "FieldForce",
+            "DipoleForce",
+            "ContactForce",
+            "PushForce",
+            "KernelForce"
+        ])
+    );
+    assert_eq!(pushed["force_kernels"], serde_json::json!(["weight"]));
+}

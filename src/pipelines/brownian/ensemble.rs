@@ -36,7 +36,7 @@ pub fn replicate_seed(seed: u64, k: u64) -> u64 {
 /// or why it failed.
 struct Replicate {
     result: Option<RunResult>,
-    meta: Option<(StartRegions, BrownianConfig)>,
+    meta: Option<(StartRegions, BrownianConfig, serde_json::Map<String, Value>)>,
     error: Option<SimError>,
 }
 
@@ -113,11 +113,14 @@ pub fn run_ensemble(
         let w = &sim.app.world;
         progress(w.resource::<StepClock>().step - last.load(Ordering::Relaxed));
         let meta = (k == 0).then(|| {
+            let mut forces = serde_json::Map::new();
+            crate::sim::force_keys(w, &mut forces);
             (
                 w.get_resource::<StartRegions>()
                     .cloned()
                     .unwrap_or_default(),
                 w.resource::<BrownianConfig>().clone(),
+                forces,
             )
         });
         Some(Replicate {
@@ -139,10 +142,15 @@ pub fn run_ensemble(
         }
         out.extend(r.result);
     }
-    let Some((regions, config)) = meta else {
+    let Some((regions, config, forces)) = meta else {
         return Err(error.unwrap_or(SimError::NothingToRun));
     };
     let mut summary = summary_of(&out, &regions, &config, started.elapsed().as_secs_f64());
+    if let Value::Object(map) = &mut summary {
+        for (k, v) in forces {
+            map.entry(k).or_insert(v);
+        }
+    }
     let complete = out.len() as u64 == runs && out.iter().all(|r| r.steps >= config.steps);
     let interrupted = match &error {
         Some(_) => Some("error".to_string()),
