@@ -174,6 +174,15 @@ impl Simulation {
             app.world.insert_resource(ForceComponents::WorkspaceOnly);
         }
         app.finish().map_err(|e| SimError::Schedule(e.0))?;
+        if let Some(frame) = &options.resume_from {
+            // the plugins' own state, from the keys their status providers wrote
+            let status = match frame.status_json.trim() {
+                "" => Value::Object(Default::default()),
+                text => serde_json::from_str(text)
+                    .map_err(|e| SimError::Resume(format!("the frame's status: {e}")))?,
+            };
+            app.restore(&status).map_err(SimError::Resume)?;
+        }
         if let Some(path) = &options.record {
             let writer = open_recording(&mut app, path, scene, pipeline.as_ref(), seed)?;
             let every = app
@@ -278,15 +287,7 @@ impl Simulation {
         let mut summary = self.pipeline.summary(&self.app.world, &run);
         if let Value::Object(map) = &mut summary {
             force_keys(&self.app.world, map);
-        }
-        if let (Some(extra), Value::Object(map)) =
-            (self.app.world.get_resource::<SummaryExtras>(), &mut summary)
-        {
-            for (k, f) in &extra.0 {
-                if let Some(v) = f(&self.app.world) {
-                    map.insert(k.clone(), v);
-                }
-            }
+            summary_extras(&self.app.world, map);
         }
         summary
     }
@@ -499,5 +500,17 @@ pub(crate) fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>
         && !k.is_empty()
     {
         map.entry("force_kernels").or_insert(k.names().into());
+    }
+}
+
+/// The keys plugins added to [`SummaryExtras`], computed on `world`, into `map` (replacing
+/// the pipeline's key of the same name).
+pub(crate) fn summary_extras(world: &World, map: &mut serde_json::Map<String, Value>) {
+    if let Some(extra) = world.get_resource::<SummaryExtras>() {
+        for (k, f) in &extra.0 {
+            if let Some(v) = f(world) {
+                map.insert(k.clone(), v);
+            }
+        }
     }
 }

@@ -58,6 +58,20 @@ pub trait SimPlugin: Any + Send + Sync {
     fn params(&self) -> serde_json::Value {
         serde_json::Value::Null
     }
+    /// Restore the plugin's own state when a run resumes from a recorded frame (`magsep
+    /// replay --resume`, `magsep::replay::resume`), called in build order after every plugin's
+    /// `finish`. `status` is the frame's status object: the keys that the world's
+    /// [`FrameStatusProviders`](crate::recorder::FrameStatusProviders) wrote at that frame, so
+    /// a plugin with state (a counter, an accumulated observable) registers a provider of its
+    /// key in `build` and reads it back here. Default: nothing, the plugin's resources start
+    /// afresh from its `build`.
+    ///
+    /// # Errors
+    /// A message when the frame does not hold what the plugin needs (the resume fails with
+    /// it, naming the plugin).
+    fn restore(&self, _world: &mut World, _status: &serde_json::Value) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// A schedule that cannot be built (ambiguity, cycle), with the systems named.
@@ -88,6 +102,7 @@ pub struct SimApp {
     /// Registered force contributions, in summation order.
     pub forces: ForceRegistry,
     plugins: Vec<FinishHook>,
+    built: Vec<Arc<dyn SimPlugin>>,
     plugin_names: Vec<String>,
     plugin_params: Vec<serde_json::Value>,
     /// The schedule runs one system after the other on a thread of rayon's pool
@@ -115,6 +130,7 @@ impl SimApp {
             observe,
             forces: ForceRegistry::default(),
             plugins: Vec::new(),
+            built: Vec::new(),
             plugin_names: Vec::new(),
             plugin_params: Vec::new(),
             in_pool: false,
@@ -138,8 +154,23 @@ impl SimApp {
         plugin.build(self);
         self.plugin_names.push(name);
         self.plugin_params.push(plugin.params());
+        self.built.push(plugin.clone());
         self.plugins.push(Box::new(move |w| plugin.finish(w)));
         self
+    }
+
+    /// Give every plugin, in build order, the status of the frame a resumed run starts from
+    /// ([`SimPlugin::restore`]); call after [`Self::finish`].
+    ///
+    /// # Errors
+    /// The first plugin's refusal, prefixed with its name.
+    pub fn restore(&mut self, status: &serde_json::Value) -> Result<(), String> {
+        for (plugin, name) in self.built.iter().zip(&self.plugin_names) {
+            plugin
+                .restore(&mut self.world, status)
+                .map_err(|e| format!("plugin {name} cannot resume from the frame: {e}"))?;
+        }
+        Ok(())
     }
 
     /// Register force contribution `T` (summed into `NetForce` in registration order) and

@@ -87,7 +87,8 @@ fn a_particle_fluid_run_records_step_0_and_its_final_step() {
     assert!(rec.truncated.is_none());
 }
 
-/// A user observer: counts steps and adds its count to the summary.
+/// A user observer: counts steps and adds its count to the summary; its count is written to
+/// every frame's status and read back when a run resumes.
 #[derive(Resource, Default)]
 struct Counted(u64);
 
@@ -107,8 +108,21 @@ impl SimPlugin for CountPlugin {
             .push(("counted_steps".into(), |w| {
                 w.get_resource::<Counted>().map(|c| c.0.into())
             }));
+        app.world
+            .get_resource_or_init::<magsep::plugins::recorder::FrameStatusProviders>()
+            .set("counted_steps", |w| {
+                w.get_resource::<Counted>().map(|c| c.0.into())
+            });
         app.schedule
             .add_systems(count_steps.in_set(SimSystems::Observe));
+    }
+
+    fn restore(&self, world: &mut World, status: &serde_json::Value) -> Result<(), String> {
+        let n = status["counted_steps"]
+            .as_u64()
+            .ok_or("the frame has no counted_steps")?;
+        world.insert_resource(Counted(n));
+        Ok(())
     }
 }
 
@@ -123,6 +137,21 @@ fn builder_plugins_act_and_add_summary_keys() {
         .unwrap();
     assert_eq!(summary["counted_steps"], summary["steps"]);
     assert_eq!(summary["steps"], 100);
+    // through the pipeline's own run (`magsep run`): the key is there too, replicate 0's
+    // under `replicate_0` when the scene runs several replicates
+    let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(CountPlugin);
+    let options = RunOptions {
+        plugins: vec![plugin],
+        ..Default::default()
+    };
+    let one = magsep::sim::run_scene(&scene, &options, &NoProgress).unwrap();
+    assert_eq!(one["counted_steps"], 100, "{one}");
+    let text = brownian().replace("duration = 0.005", "duration = 0.005\nruns = 2");
+    let two = parse_scene(&text, &Default::default()).unwrap();
+    let two = magsep::sim::run_scene(&two, &options, &NoProgress).unwrap();
+    assert_eq!(two["runs"], 2);
+    assert_eq!(two["replicate_0"]["counted_steps"], 100, "{two}");
+    assert!(two.get("counted_steps").is_none());
 }
 
 #[test]
@@ -156,10 +185,57 @@ fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
         matches!(err, magsep::error::ReplayError::MissingPlugins(ref m) if m.contains("count_steps")),
         "{err}"
     );
-    // with it: the run continues to its end
+    // with it: the run continues to its end, and the plugin's count from the frame's status
+    // (60) on, as if never interrupted
     let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(CountPlugin);
     let summary = resume(&path, &Default::default(), None, &[plugin], &NoProgress).unwrap();
     assert_eq!(summary["steps"], 100);
+    assert_eq!(summary["counted_steps"], 100, "{summary}");
+}
+
+/// [`CountPlugin`] without a restore: its count starts afresh on resume.
+#[derive(Clone)]
+struct ForgetfulCountPlugin;
+
+impl SimPlugin for ForgetfulCountPlugin {
+    fn build(&self, app: &mut SimApp) {
+        CountPlugin.build(app);
+    }
+    fn name(&self) -> String {
+        "CountPlugin".into()
+    }
+}
+
+#[test]
+fn a_plugin_that_does_not_restore_its_state_starts_afresh_and_a_refusal_names_it() {
+    let scene = parse_scene(&brownian(), &Default::default()).unwrap();
+    let path = tmp("forgetful.mcap");
+    let mut sim = Simulation::builder(&scene)
+        .add_plugin(CountPlugin)
+        .record(&path)
+        .build()
+        .unwrap();
+    while sim.app.world.resource::<StepClock>().step < 60 {
+        sim.step();
+    }
+    drop(sim);
+    let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(ForgetfulCountPlugin);
+    let summary = resume(&path, &Default::default(), None, &[plugin], &NoProgress).unwrap();
+    assert_eq!(summary["counted_steps"], 40, "{summary}");
+    // a recording whose frames lack the plugin's key: the resume fails naming the plugin
+    let bare = tmp("bare.mcap");
+    let mut sim = Simulation::builder(&scene).record(&bare).build().unwrap();
+    while sim.app.world.resource::<StepClock>().step < 60 {
+        sim.step();
+    }
+    drop(sim);
+    let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(CountPlugin);
+    let err = resume(&bare, &Default::default(), None, &[plugin], &NoProgress).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("CountPlugin") && text.contains("no counted_steps"),
+        "{text}"
+    );
 }
 
 /// The handle of [`StepChannelPlugin`]'s channel, once added.

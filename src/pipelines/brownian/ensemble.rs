@@ -113,14 +113,23 @@ pub fn run_ensemble(
         let w = &sim.app.world;
         progress(w.resource::<StepClock>().step - last.load(Ordering::Relaxed));
         let meta = (k == 0).then(|| {
-            let mut forces = serde_json::Map::new();
-            crate::sim::force_keys(w, &mut forces);
+            let mut keys = serde_json::Map::new();
+            crate::sim::force_keys(w, &mut keys);
+            // the plugins' summary keys: the run's own when it is the only one, else replicate
+            // 0's under `replicate_0` (a plugin's key need not be a mean over replicates)
+            let mut extras = serde_json::Map::new();
+            crate::sim::summary_extras(w, &mut extras);
+            if runs == 1 {
+                keys.extend(extras);
+            } else if !extras.is_empty() {
+                keys.insert("replicate_0".into(), Value::Object(extras));
+            }
             (
                 w.get_resource::<StartRegions>()
                     .cloned()
                     .unwrap_or_default(),
                 w.resource::<BrownianConfig>().clone(),
-                forces,
+                keys,
             )
         });
         Some(Replicate {
@@ -142,13 +151,13 @@ pub fn run_ensemble(
         }
         out.extend(r.result);
     }
-    let Some((regions, config, forces)) = meta else {
+    let Some((regions, config, plugin_keys)) = meta else {
         return Err(error.unwrap_or(SimError::NothingToRun));
     };
     let mut summary = summary_of(&out, &regions, &config, started.elapsed().as_secs_f64());
     if let Value::Object(map) = &mut summary {
-        for (k, v) in forces {
-            map.entry(k).or_insert(v);
+        for (k, v) in plugin_keys {
+            map.insert(k, v);
         }
     }
     let complete = out.len() as u64 == runs && out.iter().all(|r| r.steps >= config.steps);
