@@ -489,7 +489,7 @@ pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<Value, String>
 /// pipeline's and the plugins', type names without paths) and `force_kernels` (the registered
 /// external force kernels' names), so a run's summary says which forces acted on it; a key is
 /// left out when nothing is registered, and a key the pipeline set is kept.
-pub(crate) fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>) {
+pub fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>) {
     if let Some(reg) = world.get_resource::<ForceRegistry>()
         && !reg.names.is_empty()
     {
@@ -505,7 +505,7 @@ pub(crate) fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>
 
 /// The keys plugins added to [`SummaryExtras`], computed on `world`, into `map` (replacing
 /// the pipeline's key of the same name).
-pub(crate) fn summary_extras(world: &World, map: &mut serde_json::Map<String, Value>) {
+pub fn summary_extras(world: &World, map: &mut serde_json::Map<String, Value>) {
     if let Some(extra) = world.get_resource::<SummaryExtras>() {
         for (k, f) in &extra.0 {
             if let Some(v) = f(world) {

@@ -376,7 +376,10 @@ pub trait Pipeline: Send + Sync + 'static {
     /// `None` lets the driver run one simulation. It must honour [`RunOptions::stop`] as the
     /// driver does: pass it to every simulation it runs (each polls it between steps), start
     /// no more work once it is set, and return the summary of what ran, marked
-    /// `"interrupted": true` and `"interrupted_by"` (`crate::sim::mark_interrupted`).
+    /// `"interrupted": true` and `"interrupted_by"` (`crate::sim::mark_interrupted`). A summary
+    /// it computes itself should carry the keys [`Simulation::summary`](crate::sim::Simulation::summary)
+    /// adds: the forces that acted (`crate::sim::force_keys`) and the plugins' keys
+    /// (`crate::sim::summary_extras`).
     ///
     /// # Errors
     /// [`SimError`] of the run.
