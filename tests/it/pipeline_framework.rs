@@ -154,20 +154,25 @@ fn builder_plugins_act_and_add_summary_keys() {
     assert!(two.get("counted_steps").is_none());
 }
 
-#[test]
-fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
+/// The brownian scene recorded (with `plugin` if any) and stopped after step 60, as a killed
+/// run would be: its last frame is step 60.
+fn recorded_to_step_60(name: &str, plugin: Option<CountPlugin>) -> std::path::PathBuf {
     let scene = parse_scene(&brownian(), &Default::default()).unwrap();
-    let path = tmp("with_plugin.mcap");
-    let mut sim = Simulation::builder(&scene)
-        .add_plugin(CountPlugin)
-        .record(&path)
-        .build()
-        .unwrap();
-    // stop half-way, as a killed run would: the recording ends at step 60
+    let path = tmp(name);
+    let mut builder = Simulation::builder(&scene).record(&path);
+    if let Some(p) = plugin {
+        builder = builder.add_plugin(p);
+    }
+    let mut sim = builder.build().unwrap();
     while sim.app.world.resource::<StepClock>().step < 60 {
         sim.step();
     }
-    drop(sim);
+    path
+}
+
+#[test]
+fn resume_refuses_a_recording_made_with_a_plugin_the_program_lacks() {
+    let path = recorded_to_step_60("with_plugin.mcap", Some(CountPlugin));
     let rec = read_recording(&path).unwrap();
     assert_eq!(rec.frames.last().unwrap().step, 60);
     let plugins: Vec<String> = rec
@@ -208,27 +213,12 @@ impl SimPlugin for ForgetfulCountPlugin {
 
 #[test]
 fn a_plugin_that_does_not_restore_its_state_starts_afresh_and_a_refusal_names_it() {
-    let scene = parse_scene(&brownian(), &Default::default()).unwrap();
-    let path = tmp("forgetful.mcap");
-    let mut sim = Simulation::builder(&scene)
-        .add_plugin(CountPlugin)
-        .record(&path)
-        .build()
-        .unwrap();
-    while sim.app.world.resource::<StepClock>().step < 60 {
-        sim.step();
-    }
-    drop(sim);
+    let path = recorded_to_step_60("forgetful.mcap", Some(CountPlugin));
     let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(ForgetfulCountPlugin);
     let summary = resume(&path, &Default::default(), None, &[plugin], &NoProgress).unwrap();
     assert_eq!(summary["counted_steps"], 40, "{summary}");
     // a recording whose frames lack the plugin's key: the resume fails naming the plugin
-    let bare = tmp("bare.mcap");
-    let mut sim = Simulation::builder(&scene).record(&bare).build().unwrap();
-    while sim.app.world.resource::<StepClock>().step < 60 {
-        sim.step();
-    }
-    drop(sim);
+    let bare = recorded_to_step_60("bare.mcap", None);
     let plugin: std::sync::Arc<dyn SimPlugin> = std::sync::Arc::new(CountPlugin);
     let err = resume(&bare, &Default::default(), None, &[plugin], &NoProgress).unwrap_err();
     let text = err.to_string();
