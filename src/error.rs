@@ -271,7 +271,18 @@ pub enum ReplayError {
         "the recording was made with plugins this program lacks: {0}; continuing without them would silently change the run (build a binary with them, e.g. through magsep::cli::main_with)"
     )]
     MissingPlugins(String),
-    /// The pipeline cannot do this (e.g. resume).
+    /// The recorded run's forces differ from this program's (another kernel, a contribution
+    /// more or less).
+    #[error(
+        "the recording's forces differ from this program's: recorded {recorded}, here {here}; continuing would silently change the run (resume with the program and plugins that made it)"
+    )]
+    ForcesDiffer {
+        /// The recorded forces (JSON).
+        recorded: String,
+        /// This program's (JSON).
+        here: String,
+    },
+    /// The pipeline cannot do this (e.g. resume), or the frame does not fit it or a plugin.
     #[error("{0}")]
     Unsupported(String),
     /// The continued run failed.

@@ -290,15 +290,26 @@ pub fn resume(
     };
     // the frame fits the pipeline and the schedule has the recorded systems: checked on a
     // simulation that records nothing, before the run
+    // (a frame that does not fit, a plugin's restore refusing it, a schedule this program
+    // refuses: bad input, exit 2 from the CLI)
     let sim = Simulation::from_scene(&scene, options.clone()).map_err(|e| match e {
-        SimError::Resume(m) if m.contains("does not record enough state") => {
-            ReplayError::Unsupported(m)
-        }
+        SimError::Resume(m) => ReplayError::Unsupported(format!("cannot resume: {m}")),
+        SimError::Schedule(m) => ReplayError::Unsupported(m),
         other => ReplayError::Sim(other),
     })?;
     let missing = missing_systems(&meta.schedule, &sim.app.resolved_schedule());
     if !missing.is_empty() {
         return Err(ReplayError::MissingPlugins(missing.join(", ")));
+    }
+    // force kernels are not systems: a kernel of another name or kind passes the check above
+    if let Some(recorded) = meta.extra.get(crate::sim::FORCES_KEY) {
+        let here = crate::sim::forces_metadata(&sim.app.world);
+        if *recorded != here {
+            return Err(ReplayError::ForcesDiffer {
+                recorded: recorded.clone(),
+                here,
+            });
+        }
     }
     drop(sim);
     // the pipeline's own way: a brownian ensemble resumes its recorded replicate 0 and runs

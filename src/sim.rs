@@ -13,7 +13,7 @@ use magsep_plugins::group::PipelineGroup;
 use magsep_plugins::record::{
     FibreShape, FrameBuffering, PluginInfo, RecordingMetadata, RecordingWriter,
 };
-use magsep_plugins::recorder::{Recorder, record_now, recording_error};
+use magsep_plugins::recorder::{FrameStatusProviders, Recorder, record_now, recording_error};
 use magsep_systems::forces::{ExternalForces, ForceComponents, ForceRegistry};
 use serde_json::Value;
 
@@ -367,6 +367,9 @@ fn open_recording(
             .collect(),
         extra: overrides_metadata(&scene.overrides),
     };
+    let mut meta = meta;
+    meta.extra
+        .insert(FORCES_KEY.to_string(), forces_metadata(&app.world));
     // the header, encoding, compression and writes run on a writer thread of their own
     let mut writer = RecordingWriter::create_background(path, &meta)?;
     if !scene.record.as_ref().is_some_and(|r| r.flush_every_frame) {
@@ -408,7 +411,28 @@ fn open_recording(
                 .collect(),
         );
     }
+    // the pipeline's status keys are set here, after the plugins': a plugin's key of the same
+    // name would be replaced without a word, so it is refused
+    let plugins_keys = app.world.remove_resource::<FrameStatusProviders>();
     pipeline.prepare_recording(&mut app.world, &mut writer);
+    if let Some(plugins_keys) = plugins_keys {
+        let mut keys = app.world.get_resource_or_init::<FrameStatusProviders>();
+        for (key, f) in plugins_keys.0 {
+            if key == "container" || keys.0.iter().any(|(k, _)| *k == key) {
+                drop(writer);
+                let _ = std::fs::remove_file(path);
+                return Err(SimError::Schedule(format!(
+                    "a plugin's frame-status key `{key}` is {}: rename it",
+                    if key == "container" {
+                        "the recorder's own (the frame's walls)".to_string()
+                    } else {
+                        format!("the {} pipeline's own", pipeline.name())
+                    }
+                )));
+            }
+            keys.0.push((key, f));
+        }
+    }
     Ok(writer)
 }
 
@@ -428,6 +452,25 @@ fn overrides_metadata(overrides: &[String]) -> std::collections::BTreeMap<String
 /// The key of [`RecordingMetadata::extra`] that lists the overrides of the run (a JSON list of
 /// `PATH=VALUE` strings); the recorded scene text already has them applied.
 pub const OVERRIDES_KEY: &str = "overrides";
+
+/// The key of [`RecordingMetadata::extra`] that holds the forces of the run
+/// ([`forces_metadata`]): a resume refuses a program whose forces differ.
+pub const FORCES_KEY: &str = "forces";
+
+/// The forces registered in `world` as recorded under [`FORCES_KEY`]: a JSON object with
+/// `force_contributions` (full type names, in summation order) and `force_kernels` (the
+/// external kernels' names, in order).
+pub fn forces_metadata(world: &World) -> String {
+    let contributions = world
+        .get_resource::<ForceRegistry>()
+        .map(|r| r.names.clone())
+        .unwrap_or_default();
+    let kernels: Vec<String> = world
+        .get_resource::<ExternalForces>()
+        .map(|k| k.names().into_iter().map(String::from).collect())
+        .unwrap_or_default();
+    serde_json::json!({"force_contributions": contributions, "force_kernels": kernels}).to_string()
+}
 
 /// Run `scene` to the end the pipeline's way (one simulation, or e.g. replicates), reporting
 /// to `progress`; returns the summary. A set [`RunOptions::stop`] ends the run early with the
@@ -485,32 +528,60 @@ pub fn run_scene_file(path: &Path, options: RunOptions) -> Result<Value, String>
     run_scene(&scene, &options, &NoProgress).map_err(|e| e.to_string())
 }
 
-/// The summary's `force_contributions` (every registered contribution in summation order, the
-/// pipeline's and the plugins', type names without paths) and `force_kernels` (the registered
-/// external force kernels' names), so a run's summary says which forces acted on it; a key is
-/// left out when nothing is registered, and a key the pipeline set is kept.
+/// The summary's `force_contributions` (every registered force contribution in summation
+/// order, the pipeline's and the plugins', type names without paths; a pipeline registers its
+/// contributions whether or not the scene switches them on: its own keys say which act) and
+/// `force_kernels` (the registered external force kernels' names), both `[]` when nothing is
+/// registered; a key the pipeline set is kept.
 pub fn force_keys(world: &World, map: &mut serde_json::Map<String, Value>) {
-    if let Some(reg) = world.get_resource::<ForceRegistry>()
-        && !reg.names.is_empty()
-    {
-        let names: Vec<String> = reg.names.iter().map(|n| short_name(n)).collect();
-        map.entry("force_contributions").or_insert(names.into());
-    }
-    if let Some(k) = world.get_resource::<ExternalForces>()
-        && !k.is_empty()
-    {
-        map.entry("force_kernels").or_insert(k.names().into());
-    }
+    let names: Vec<String> = (world.get_resource::<ForceRegistry>())
+        .map(|r| r.names.iter().map(|n| short_name(n)).collect())
+        .unwrap_or_default();
+    map.entry("force_contributions").or_insert(names.into());
+    let kernels: Vec<&str> = (world.get_resource::<ExternalForces>())
+        .map(|k| k.names())
+        .unwrap_or_default();
+    map.entry("force_kernels").or_insert(kernels.into());
 }
 
-/// The keys plugins added to [`SummaryExtras`], computed on `world`, into `map` (replacing
-/// the pipeline's key of the same name).
+/// The keys plugins added to [`SummaryExtras`], computed on `world`, into `map` (see
+/// [`merge_plugin_keys`]).
 pub fn summary_extras(world: &World, map: &mut serde_json::Map<String, Value>) {
+    merge_plugin_keys(map, plugin_summary_keys(world));
+}
+
+/// The keys plugins added to [`SummaryExtras`], computed on `world`.
+pub fn plugin_summary_keys(world: &World) -> serde_json::Map<String, Value> {
+    let mut out = serde_json::Map::new();
     if let Some(extra) = world.get_resource::<SummaryExtras>() {
         for (k, f) in &extra.0 {
             if let Some(v) = f(world) {
-                map.insert(k.clone(), v);
+                out.insert(k.clone(), v);
             }
+        }
+    }
+    out
+}
+
+/// Add the plugins' `keys` to the summary `map`. A key the summary already has (the
+/// pipeline's or the driver's) is kept, and the plugin's value left out with a line in the
+/// summary's `warnings` naming the key.
+pub fn merge_plugin_keys(
+    map: &mut serde_json::Map<String, Value>,
+    keys: serde_json::Map<String, Value>,
+) {
+    for (k, v) in keys {
+        if !map.contains_key(&k) {
+            map.insert(k, v);
+            continue;
+        }
+        let line = format!(
+            "a plugin's summary key `{k}` is also the summary's own key: the plugin's value is \
+             left out (rename the key)"
+        );
+        match map.entry("warnings").or_insert(Value::Array(Vec::new())) {
+            Value::Array(w) => w.push(line.into()),
+            other => *other = Value::Array(vec![other.take(), line.into()]),
         }
     }
 }

@@ -91,7 +91,11 @@ pub struct RecordTiming {
 pub type StatusFn = fn(&World) -> Option<Value>;
 
 /// The keys of every frame's `status_json` beyond `container`, each with the function that
-/// computes it (a resource; a pipeline registers what it needs to replay or resume a frame).
+/// computes it (a resource; a pipeline registers what it needs to replay or resume a frame,
+/// a plugin what it needs to restore its state, see `SimPlugin::restore`). The keys sit at the
+/// top level of `status_json`; `container` and the pipeline's own keys (brownian: `brownian`;
+/// packing: `packing`, `driver_rng`) are reserved: magsep's driver refuses a plugin's key of
+/// one of those names when the recording opens.
 #[derive(Resource, Default, Clone)]
 pub struct FrameStatusProviders(pub Vec<(String, StatusFn)>);
 

@@ -7,7 +7,10 @@
 //! `"interrupted_by": "SIGINT"` (or `"SIGTERM"`), and the process exits with 128 + the signal
 //! number: [`EXIT_SIGINT`] (130) or [`EXIT_SIGTERM`] (143), the shell's convention. A second
 //! signal exits at once, with its own code, leaving the recording as a truncated file whose
-//! finished frames stay readable.
+//! finished frames stay readable; but a repeat of the first signal within
+//! [`REPEAT_IGNORED`] of it is ignored: `timeout -s TERM` (without `--foreground`) and a
+//! terminal's Ctrl-C to a process group can deliver one request twice, which is not a second
+//! request.
 //!
 //! SIGXFSZ (a write past the process's file-size limit, `ulimit -f`) would kill the process by
 //! default, with no summary and no word on why; [`survive_file_size_limit`] replaces that
@@ -20,6 +23,10 @@ use crate::sim::StopFlag;
 pub const EXIT_SIGINT: i32 = 130;
 /// Exit code of a run stopped by SIGTERM (128 + 15).
 pub const EXIT_SIGTERM: i32 = 143;
+
+/// How soon after the first signal a repeat of the same signal is taken as the same request
+/// (ignored) rather than a second one (exit at once).
+pub const REPEAT_IGNORED: std::time::Duration = std::time::Duration::from_secs(1);
 
 pub use imp::{SignalGuard, install, survive_file_size_limit};
 
@@ -52,7 +59,8 @@ mod imp {
     }
 
     /// Handle SIGINT and SIGTERM: the first sets `stop` (reason `SIGINT` or `SIGTERM`), the
-    /// second exits the process at once with 128 + its number.
+    /// second exits the process at once with 128 + its number (a repeat of the first within
+    /// [`super::REPEAT_IGNORED`] is ignored).
     ///
     /// # Errors
     /// The OS error when the handlers or their thread cannot be set up.
@@ -65,14 +73,28 @@ mod imp {
         let thread = std::thread::Builder::new()
             .name("magsep-signals".into())
             .spawn(move || {
+                let mut first_at: Option<std::time::Instant> = None;
                 for signal in signals.forever() {
                     let first = seen
                         .compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst)
                         .is_ok();
                     if !first {
-                        eprint(format!("\nmagsep: {} again: exiting at once", name(signal)));
+                        let echo = seen.load(Ordering::SeqCst) == signal
+                            && first_at.is_some_and(|t| t.elapsed() < super::REPEAT_IGNORED);
+                        if echo {
+                            // e.g. `timeout`, which signals the process and then its group
+                            continue;
+                        }
+                        let first = seen.load(Ordering::SeqCst);
+                        let what = if first == signal {
+                            format!("{} again", name(signal))
+                        } else {
+                            format!("{} after {}", name(signal), name(first))
+                        };
+                        eprint(format!("\nmagsep: {what}: exiting at once"));
                         std::process::exit(128 + signal);
                     }
+                    first_at = Some(std::time::Instant::now());
                     eprint(format!(
                         "\nmagsep: {} received: ending the current step and closing the recording \
                          (send it again to exit at once)",

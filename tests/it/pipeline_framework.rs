@@ -343,3 +343,97 @@ fn a_plugin_channel_has_one_message_per_frame_step_0_final_and_interrupted_inclu
         why.entries
     );
 }
+
+/// Uniform force kernel along -z \[N\] (for the forces check of a resume).
+struct Sink;
+
+impl magsep::systems::forces::ExternalForce for Sink {
+    fn force_torque(
+        &self,
+        _p: &magsep::systems::forces::ParticleState,
+    ) -> (glam::DVec3, glam::DVec3) {
+        (glam::DVec3::new(0.0, 0.0, -1e-15), glam::DVec3::ZERO)
+    }
+}
+
+/// Adds [`Sink`] as kernel `sink`, a summary key named as the pipeline's `steps`, and (with
+/// `status_key`) a frame-status key of the given name.
+#[derive(Clone)]
+struct SinkPlugin {
+    status_key: Option<&'static str>,
+}
+
+impl SimPlugin for SinkPlugin {
+    fn build(&self, app: &mut SimApp) {
+        app.add_external_force("sink", std::sync::Arc::new(Sink));
+        app.world
+            .get_resource_or_init::<SummaryExtras>()
+            .0
+            .push(("steps".into(), |_| Some(7.into())));
+        if let Some(key) = self.status_key {
+            app.world
+                .get_resource_or_init::<magsep::plugins::recorder::FrameStatusProviders>()
+                .set(key, |_| Some(1.into()));
+        }
+    }
+}
+
+#[test]
+fn a_resume_with_other_forces_is_refused_and_plugin_keys_never_replace_the_summarys() {
+    let scene = parse_scene(
+        &brownian().replace(
+            "time_step = 5e-5",
+            "time_step = 5e-5\nstep_control = { kind = \"fixed\" }",
+        ),
+        &Default::default(),
+    )
+    .unwrap();
+    let path = tmp("forces.mcap");
+    let mut sim = Simulation::builder(&scene).record(&path).build().unwrap();
+    while sim.app.world.resource::<StepClock>().step < 60 {
+        sim.step();
+    }
+    drop(sim);
+    // a kernel more than the recorded run had: refused before anything runs
+    let plugin: std::sync::Arc<dyn SimPlugin> =
+        std::sync::Arc::new(SinkPlugin { status_key: None });
+    let err = resume(
+        &path,
+        &Default::default(),
+        None,
+        std::slice::from_ref(&plugin),
+        &NoProgress,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, magsep::error::ReplayError::ForcesDiffer { ref recorded, ref here }
+            if !recorded.contains("sink") && here.contains("\"sink\"")),
+        "{err}"
+    );
+    // the plugin's `steps` does not replace the pipeline's: left out, with a warning
+    let summary = Simulation::builder(&scene)
+        .add_plugin(SinkPlugin { status_key: None })
+        .build()
+        .unwrap()
+        .run(|_| {})
+        .unwrap();
+    assert_eq!(summary["steps"], 100);
+    assert_eq!(summary["force_kernels"], serde_json::json!(["sink"]));
+    let warnings = summary["warnings"].to_string();
+    assert!(warnings.contains("summary key `steps`"), "{warnings}");
+    // a frame-status key named as the pipeline's: refused when the recording opens
+    let clash = tmp("clash.mcap");
+    let err = Simulation::builder(&scene)
+        .add_plugin(SinkPlugin {
+            status_key: Some("brownian"),
+        })
+        .record(&clash)
+        .build()
+        .err()
+        .expect("a clashing status key is refused");
+    assert!(
+        matches!(err, SimError::Schedule(ref m) if m.contains("`brownian`")),
+        "{err}"
+    );
+    assert!(!clash.exists());
+}

@@ -1,6 +1,7 @@
 //! Kill tests of `magsep run --record`: SIGINT and SIGTERM end the run gracefully (exit 130 /
 //! 143, the partial summary on stdout marked interrupted, a complete recording that `magsep
-//! info` reports as interrupted), a second signal exits at once, and a recording write
+//! info` reports as interrupted), a second signal exits at once (a repeat of the first within a
+//! second is the same request), and a recording write
 //! failure (a file-size limit) stops the run at once with exit 1.
 
 use std::io::Read;
@@ -220,18 +221,43 @@ fn sigterm_stops_every_replicate_of_a_brownian_ensemble() {
 }
 
 #[test]
+fn a_repeat_of_the_signal_within_a_second_is_the_same_request() {
+    // as `timeout -s TERM` sends it, to the process and then to its group
+    let record = tmp("echo.mcap");
+    let mut child = run_recorded("brownian_slow_steps.toml", &record);
+    wait_for_frames(&mut child, &record, 1);
+    kill(&child, "TERM");
+    std::thread::sleep(Duration::from_millis(100));
+    kill(&child, "TERM");
+    let (out, _) = finish(child, Duration::from_secs(20));
+    assert_eq!(out.status.code(), Some(143), "stderr: {}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("exiting at once"),
+        "{}",
+        stderr(&out)
+    );
+    let summary = summary_of(&out);
+    assert_eq!(summary["interrupted_by"], "SIGTERM", "{summary}");
+    assert_info_interrupted(&record, "SIGTERM");
+}
+
+#[test]
 fn a_second_signal_exits_at_once() {
     let record = tmp("twice.mcap");
     let mut child = run_recorded("brownian_slow_steps.toml", &record);
-    // frame 0 is written just before the first step, which takes about a second
+    // frame 0 is written just before the first step, which takes about a second; a different
+    // signal is a second request however soon it comes
     wait_for_frames(&mut child, &record, 1);
-    kill(&child, "INT");
+    kill(&child, "TERM");
     std::thread::sleep(Duration::from_millis(100));
     kill(&child, "INT");
     let (out, took) = finish(child, Duration::from_secs(10));
     assert_eq!(out.status.code(), Some(130), "stderr: {}", stderr(&out));
     let err = stderr(&out);
-    assert!(err.contains("SIGINT again: exiting at once"), "{err}");
+    assert!(
+        err.contains("SIGINT after SIGTERM: exiting at once"),
+        "{err}"
+    );
     // no graceful end: no summary, and the recording has no footer but its frames are readable
     assert!(
         out.stdout.is_empty(),

@@ -36,9 +36,18 @@ pub fn replicate_seed(seed: u64, k: u64) -> u64 {
 /// or why it failed.
 struct Replicate {
     result: Option<RunResult>,
-    meta: Option<(StartRegions, BrownianConfig, serde_json::Map<String, Value>)>,
+    meta: Option<ReplicateMeta>,
     error: Option<SimError>,
 }
+
+/// What the summary takes from replicate 0's world: the force keys, the plugins' summary keys,
+/// the start regions and the configuration.
+type ReplicateMeta = (
+    serde_json::Map<String, Value>,
+    serde_json::Map<String, Value>,
+    StartRegions,
+    BrownianConfig,
+);
 
 /// Run `runs` replicates of `scene` (recording only replicate 0) and summarise them.
 /// `progress` is called with the number of steps just completed (from any thread).
@@ -113,23 +122,15 @@ pub fn run_ensemble(
         let w = &sim.app.world;
         progress(w.resource::<StepClock>().step - last.load(Ordering::Relaxed));
         let meta = (k == 0).then(|| {
-            let mut keys = serde_json::Map::new();
-            crate::sim::force_keys(w, &mut keys);
-            // the plugins' summary keys: the run's own when it is the only one, else replicate
-            // 0's under `replicate_0` (a plugin's key need not be a mean over replicates)
-            let mut extras = serde_json::Map::new();
-            crate::sim::summary_extras(w, &mut extras);
-            if runs == 1 {
-                keys.extend(extras);
-            } else if !extras.is_empty() {
-                keys.insert("replicate_0".into(), Value::Object(extras));
-            }
+            let mut forces = serde_json::Map::new();
+            crate::sim::force_keys(w, &mut forces);
             (
+                forces,
+                crate::sim::plugin_summary_keys(w),
                 w.get_resource::<StartRegions>()
                     .cloned()
                     .unwrap_or_default(),
                 w.resource::<BrownianConfig>().clone(),
-                keys,
             )
         });
         Some(Replicate {
@@ -151,13 +152,20 @@ pub fn run_ensemble(
         }
         out.extend(r.result);
     }
-    let Some((regions, config, plugin_keys)) = meta else {
+    let Some((forces, extras, regions, config)) = meta else {
         return Err(error.unwrap_or(SimError::NothingToRun));
     };
     let mut summary = summary_of(&out, &regions, &config, started.elapsed().as_secs_f64());
     if let Value::Object(map) = &mut summary {
-        for (k, v) in plugin_keys {
-            map.insert(k, v);
+        for (k, v) in forces {
+            map.entry(k).or_insert(v);
+        }
+        // the plugins' summary keys: the run's own when it is the only one, else replicate
+        // 0's under `replicate_0` (a plugin's key need not be a mean over replicates)
+        if runs > 1 && !extras.is_empty() {
+            map.insert("replicate_0".into(), Value::Object(extras));
+        } else {
+            crate::sim::merge_plugin_keys(map, extras);
         }
     }
     let complete = out.len() as u64 == runs && out.iter().all(|r| r.steps >= config.steps);
