@@ -223,3 +223,55 @@ pub fn pair_forces_in_parts(
         lists.pair_scratch.put(pf);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_split_the_cost_evenly_and_cover_every_particle() {
+        // the first 100 particles cost 10 each, the other 900 one each: 1900 in all
+        let prefix = |i: usize| (10 * i.min(100) + i.saturating_sub(100)) as u64;
+        assert_eq!(balanced_bounds(1000, 2, prefix), vec![0, 95, 1000]);
+        let b = balanced_bounds(1000, 4, prefix);
+        assert_eq!((b[0], b[4]), (0, 1000));
+        assert!(b.windows(2).all(|w| w[0] <= w[1]));
+        for p in 0..4 {
+            let cost = prefix(b[p + 1]) - prefix(b[p]);
+            assert!((470..=480).contains(&cost), "part {p}: {cost}");
+        }
+        assert_eq!(balanced_bounds(0, 3, prefix), vec![0, 0, 0, 0]);
+        assert_eq!(balanced_bounds(5, 1, prefix), vec![0, 5]);
+    }
+
+    #[test]
+    fn every_part_runs_once_on_any_pool() {
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut v: Vec<u32> = (0..1000).collect();
+            let bounds = [0, 10, 10, 600, 1000];
+            pool.install(|| {
+                let parts = split_at_bounds(&mut v, &bounds);
+                assert_eq!(
+                    parts.iter().map(|p| p.len()).collect::<Vec<_>>(),
+                    [10, 0, 590, 400]
+                );
+                run_parts(parts, |p, part| {
+                    for x in part.iter_mut() {
+                        *x = *x * 10 + p as u32;
+                    }
+                });
+            });
+            for (i, x) in v.iter().enumerate() {
+                let p = bounds
+                    .windows(2)
+                    .position(|w| (w[0]..w[1]).contains(&i))
+                    .unwrap();
+                assert_eq!(*x, i as u32 * 10 + p as u32);
+            }
+        }
+    }
+}
