@@ -173,42 +173,40 @@ pub fn pair_forces_in_parts(
         let base = slot_bounds[p];
         if let Some(cut) = cut {
             // the pairs the part's particles own, in slot order
-            let mut k = 0;
+            let mut slots = own.iter_mut();
             for i in a..b {
                 let (js, _) = list.owned(i);
                 let (xi, ai, mi) = (x[i], view.radii[i], moments[i]);
-                for &j in js {
+                for (&j, o) in js.iter().zip(&mut slots) {
                     let j = j as usize;
-                    if let Some(o) = own.get_mut(k) {
-                        *o = dipole_pair(cut, xi - x[j], (ai, view.radii[j]), mi, moments[j]);
-                    }
-                    k += 1;
+                    *o = dipole_pair(cut, xi - x[j], (ai, view.radii[j]), mi, moments[j]);
                 }
             }
         }
+        let own: &[DVec3] = own;
         for i in a..b {
             d[i - a] = match cut {
                 Some(cut) if view.mobile[i] && moments[i] != DVec3::ZERO => {
                     let mut sum = DVec3::ZERO;
                     for (j, s) in list.entries(i) {
-                        let slot = (s != NO_SLOT).then(|| (s as usize).checked_sub(base));
-                        sum += match slot {
-                            Some(Some(k)) if j > i => own.get(k).copied().unwrap_or_default(),
-                            Some(Some(k)) if j >= a => -own.get(k).copied().unwrap_or_default(),
-                            // owned by a particle of an earlier part: its expression
-                            Some(_) => -dipole_pair(
-                                cut,
-                                x[j] - x[i],
-                                (view.radii[j], view.radii[i]),
-                                moments[j],
-                                moments[i],
-                            ),
-                            None => dipole_pair(
+                        // a slot of this part (NO_SLOT and earlier parts' slots wrap past it)
+                        sum += match own.get((s as usize).wrapping_sub(base)) {
+                            Some(&p) if j > i => p,
+                            Some(&p) => -p,
+                            None if s == NO_SLOT => dipole_pair(
                                 cut,
                                 x[i] - x[j],
                                 (view.radii[i], view.radii[j]),
                                 moments[i],
                                 moments[j],
+                            ),
+                            // owned by a particle of an earlier part: its expression
+                            None => -dipole_pair(
+                                cut,
+                                x[j] - x[i],
+                                (view.radii[j], view.radii[i]),
+                                moments[j],
+                                moments[i],
                             ),
                         };
                     }
