@@ -6,7 +6,10 @@
 //! The passes run on the system's thread. They move a few bytes per particle; splitting them
 //! among threads (bevy batches on its compute pool) cost more in wake-ups than it saved: the
 //! 2-thread rate of the LAMMPS-mirror Brownian bench rose from 2.33 M to 2.74 M
-//! particle-steps/s (mean of four interleaved rounds) when they went back to one thread.
+//! particle-steps/s (mean of four interleaved rounds) when they went back to one thread. The
+//! exception is the write-back of the fixed step ([`write_back_in_parts`]): it runs in the
+//! step's parts, each thread copying the particles it updated, so that their data stays in its
+//! cache.
 
 use bevy_ecs::prelude::*;
 use glam::DVec3;

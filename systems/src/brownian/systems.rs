@@ -23,9 +23,10 @@
 //! `tests/it/brownian_pipeline.rs`). Positions, capture flags and random streams are
 //! written back at every step.
 //!
-//! **Threads.** The numerical kernels run on the rayon pool; the component passes (writing the
-//! forces, reading `NetForce` back, the write-back) run on the system's thread
-//! ([`super::passes`] says why). Every kernel writes each particle's own value, so the
+//! **Threads.** The numerical kernels run on the rayon pool, the fixed step's phases over one
+//! split of the particles ([`super::parts`]); the write-back too when the particles fill one
+//! table, the other component passes on the system's thread ([`super::passes`]). Every kernel
+//! writes each particle's own value, so the
 //! trajectory is bitwise the same for any thread count (tested in
 //! `tests/it/brownian_pipeline.rs`).
 
