@@ -16,6 +16,7 @@ use super::contact::{remove_overlaps, swept_capture_cached};
 use super::fibre_flow::FibreFlow;
 use super::hydro::Mobility;
 use super::model::{ForceModel, ForceParts, PairLists, ParticleView};
+use super::parts::{part_bounds, run_parts, split_at_bounds};
 use super::stepper::multirate::LocalDynamics;
 use super::stepper::{Dynamics, PARTICLE_CHUNK, normal3};
 
@@ -186,20 +187,22 @@ impl PipelineDynamics<'_> {
     /// the step-start force `force(i)` \[N\], noise and update, then capture. The same
     /// expressions, in the same order per particle, as [`super::stepper::advance`] with
     /// [`StepControl::Fixed`](magsep_components::brownian::StepControl::Fixed) after
-    /// [`PipelineDynamics::velocities`] (its reference, tested bit for bit): one parallel split
-    /// instead of four.
+    /// [`PipelineDynamics::velocities`] (its reference, tested bit for bit): one parallel region
+    /// over the parts of the pair forces ([`super::parts`]) instead of four.
     pub fn fixed_free_step(
         &mut self,
         x: &mut [DVec3],
-        force: impl Fn(usize) -> DVec3 + Sync,
+        force: impl Fn(usize) -> DVec3 + Sync + Clone,
         dt: f64,
         rngs: &mut [Xoshiro256PlusPlus],
         stats: &mut BrownianStats,
     ) {
-        let (mobile, radii, eta, kt) = (&self.mobile, self.radii, self.viscosity, self.kt);
+        let (mobile, radii, eta, kt) =
+            (self.mobile.as_slice(), self.radii, self.viscosity, self.kt);
         let (ff, flow) = (self.flow_field, self.flow);
         let s = dt.sqrt();
-        let step = |(i, (xi, rng)): (usize, (&mut DVec3, &mut Xoshiro256PlusPlus))| {
+        // a `move` closure of plain values: each part runs its own copy (see `run_parts`)
+        let step = move |(i, (xi, rng)): (usize, (&mut DVec3, &mut Xoshiro256PlusPlus))| {
             let (v, b) = if mobile[i] {
                 let w = normal3(rng) * s;
                 let v = force(i) / (6.0 * std::f64::consts::PI * eta * radii[i])
@@ -214,16 +217,21 @@ impl PipelineDynamics<'_> {
         // capture needs the step's start only near fibres
         let from = (!self.model.sources.is_empty()).then(|| x.to_vec());
         let n = x.len().min(rngs.len()).min(mobile.len());
-        if n < 2 * PARTICLE_CHUNK {
-            x.iter_mut().zip(rngs.iter_mut()).enumerate().for_each(step);
-        } else {
-            x[..n]
-                .par_iter_mut()
-                .zip(rngs[..n].par_iter_mut())
-                .with_min_len(PARTICLE_CHUNK)
+        // the parts of the pair forces (each thread updates the particles whose forces it
+        // summed, see `super::parts`)
+        let bounds = part_bounds(self.lists, n);
+        let items: Vec<_> = split_at_bounds(&mut x[..n], &bounds)
+            .into_iter()
+            .zip(split_at_bounds(&mut rngs[..n], &bounds))
+            .collect();
+        let bounds = bounds.as_slice();
+        run_parts(items, move |p, (xs, rs)| {
+            let a = bounds[p];
+            xs.iter_mut()
+                .zip(rs.iter_mut())
                 .enumerate()
-                .for_each(step);
-        }
+                .for_each(|(k, v)| step((a + k, v)));
+        });
         if let Some(from) = from {
             self.accept(&from, x, 1.0);
         }

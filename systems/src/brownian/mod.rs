@@ -10,6 +10,7 @@ pub mod fibre_flow;
 pub mod hydro;
 pub mod model;
 pub mod pair;
+pub mod parts;
 pub mod passes;
 pub mod patch;
 pub mod stepper;

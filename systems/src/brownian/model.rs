@@ -126,7 +126,7 @@ pub struct ForceModel {
 /// Dipole force on `i` \[N\] from `j` at `d = x_i − x_j` within the pair's cut-off `cut` × mean
 /// radius (zero beyond): the one pair rule of every dipole kernel.
 #[inline]
-fn dipole_pair(cut: f64, d: DVec3, (ai, aj): (f64, f64), mi: DVec3, mj: DVec3) -> DVec3 {
+pub(super) fn dipole_pair(cut: f64, d: DVec3, (ai, aj): (f64, f64), mi: DVec3, mj: DVec3) -> DVec3 {
     let rc = cut * 0.5 * (ai + aj);
     if d.length_squared() < rc * rc {
         dipole_force(d, mi, mj)
@@ -304,17 +304,21 @@ impl ForceModel {
     pub fn update_lists(&self, x: &[DVec3], view: &ParticleView, lists: &mut PairLists) -> u64 {
         let amax = view.radii.iter().copied().fold(0.0, f64::max);
         let (dipole, contact) = (self.dipole_range(view), self.contact_range(view));
+        // both lists' displacement tests in the parts of the step (each thread reads the
+        // positions it wrote)
+        let (dw, cw) = super::parts::lists_within_skin(x, lists);
         let mut rebuilt = 0;
-        let mut ensure = |list: &mut VerletList, range: f64| {
+        let mut ensure = |list: &mut VerletList, range: f64, within: Option<bool>| {
             if range > 0.0 && range.is_finite() {
-                rebuilt += list.ensure(x, view.exerts, range, list_skin(range, amax)) as u64;
+                let skin = list_skin(range, amax);
+                rebuilt += list.ensure_checked(x, view.exerts, range, skin, within) as u64;
             }
         };
         if self.dipole_cutoff.is_some() {
-            ensure(&mut lists.dipole, dipole);
+            ensure(&mut lists.dipole, dipole, dw);
         }
         if self.mie.is_some() {
-            ensure(&mut lists.contact, contact);
+            ensure(&mut lists.contact, contact, cw);
         }
         rebuilt
     }
@@ -341,43 +345,17 @@ impl ForceModel {
 
     /// Dipole-dipole \[N\] and contact forces \[N\] on the mobile particles: the same values as
     /// [`ForceModel::dipole_forces`] and [`ForceModel::contact_forces`], with both sums of a
-    /// particle in one parallel pass.
+    /// particle and the pairs it owns in one parallel region over fixed parts
+    /// ([`super::parts::pair_forces_in_parts`]).
     pub fn pair_forces(
         &self,
         x: &[DVec3],
         moments: &[DVec3],
         view: &ParticleView,
         lists: &PairLists,
-        (dipole, contact): (&mut [DVec3], &mut [DVec3]),
+        out: (&mut [DVec3], &mut [DVec3]),
     ) {
-        let pf = self
-            .dipole_cutoff
-            .map(|cut| (cut, self.dipole_pair_pass(cut, x, moments, view, lists)));
-        let range = self.contact_range(view);
-        let go = |i: usize, (d, c): (&mut DVec3, &mut DVec3)| {
-            *d = match &pf {
-                Some((cut, pf)) => dipole_gather(*cut, x, moments, view, &lists.dipole, pf, i),
-                None => DVec3::ZERO,
-            };
-            *c = self.contact_force_on(x, view, lists, range, i);
-        };
-        if dipole.len() < 512 {
-            dipole
-                .iter_mut()
-                .zip(contact.iter_mut())
-                .enumerate()
-                .for_each(|(i, o)| go(i, o));
-        } else {
-            dipole
-                .par_iter_mut()
-                .zip(contact.par_iter_mut())
-                .with_min_len(128)
-                .enumerate()
-                .for_each(|(i, o)| go(i, o));
-        }
-        if let Some((_, pf)) = pf {
-            lists.pair_scratch.put(pf);
-        }
+        super::parts::pair_forces_in_parts(self, x, moments, view, lists, out);
     }
 
     /// The dipole force of each listed pair on its lower index, in its slot (the buffer

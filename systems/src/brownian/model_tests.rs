@@ -110,7 +110,7 @@ fn cached_lists_give_the_forces_of_fresh_lists_bit_for_bit() {
 }
 
 /// The fused pass (dipole gather and contact sum of a particle together) gives bit for bit
-/// the separate passes' forces, on one thread and on two, with captured particles in the
+/// the separate passes' forces, on one, two and three threads (parts), with captured particles in the
 /// mix (some exerting, some not).
 #[test]
 fn the_fused_pair_pass_equals_the_separate_passes_bit_for_bit() {
@@ -160,7 +160,8 @@ fn the_fused_pair_pass_equals_the_separate_passes_bit_for_bit() {
             "contacts"
         );
         assert!(d.iter().filter(|f| **f != DVec3::ZERO).count() > n / 2);
-        for threads in [1, 2] {
+        // three threads: a middle part, whose pairs come from the parts on both sides
+        for threads in [1, 2, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()

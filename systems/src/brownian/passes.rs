@@ -6,10 +6,97 @@
 //! The passes run on the system's thread. They move a few bytes per particle; splitting them
 //! among threads (bevy batches on its compute pool) cost more in wake-ups than it saved: the
 //! 2-thread rate of the LAMMPS-mirror Brownian bench rose from 2.33 M to 2.74 M
-//! particle-steps/s (mean of four interleaved rounds) when they went back to one thread.
+//! particle-steps/s (mean of four interleaved rounds) when they went back to one thread. The
+//! exception is the write-back of the fixed step ([`write_back_in_parts`]): it runs in the
+//! step's parts, each thread copying the particles it updated, so that their data stays in its
+//! cache.
 
 use bevy_ecs::prelude::*;
 use glam::DVec3;
+use magsep_components::prelude::*;
+
+use super::parts::{run_parts, split_at_bounds};
+use super::systems::BrownianWorkspace;
+
+/// The particles' positions and capture flags (those with a random stream, like the
+/// workspace's).
+pub type PositionRows<'w, 's> = Query<
+    'w,
+    's,
+    (Entity, &'static mut Position, Option<&'static mut Captured>),
+    With<ParticleRng>,
+>;
+/// The particles' random streams.
+pub type StreamRows<'w, 's> = Query<'w, 's, (Entity, &'static mut ParticleRng), With<Position>>;
+
+/// The write-back of positions, capture flags and random streams in the parts of the step
+/// (`bounds`, see [`super::parts`]) when the particles fill one table in workspace order (the
+/// usual case: the components are then contiguous slices, split like the workspace): each
+/// thread copies the particles it updated, so their lines stay in its cache. Every component
+/// is marked changed, as a write through `Mut` does. Returns false, having written nothing,
+/// when the layout is another.
+pub fn write_back_in_parts(
+    ws: &BrownianWorkspace,
+    bounds: &[usize],
+    q: &mut PositionRows,
+    streams: &mut StreamRows,
+) -> bool {
+    let n = ws.entities.len();
+    if n != ws.positions.len() || n != ws.captured.len() || n != ws.rngs.len() {
+        return false;
+    }
+    let (Ok(mut rows), Ok(mut rng_rows)) = (q.contiguous_iter_mut(), streams.contiguous_iter_mut())
+    else {
+        return false;
+    };
+    let (Some((es, mut pos, cap)), Some((es2, mut rng))) = (rows.next(), rng_rows.next()) else {
+        return false;
+    };
+    if rows.next().is_some()
+        || rng_rows.next().is_some()
+        || es != ws.entities.as_slice()
+        || es2 != es
+    {
+        return false;
+    }
+    pos.mark_all_as_changed();
+    rng.mark_all_as_changed();
+    let mut cap = cap;
+    let cap: &mut [Captured] = match cap.as_mut() {
+        Some(c) => {
+            c.mark_all_as_changed();
+            c.bypass_change_detection()
+        }
+        None => &mut [],
+    };
+    // no capture flags (no `Captured` in the table): empty parts
+    let cap_bounds = if cap.is_empty() {
+        vec![0; bounds.len()]
+    } else {
+        bounds.to_vec()
+    };
+    let items: Vec<_> = split_at_bounds(pos.bypass_change_detection(), bounds)
+        .into_iter()
+        .zip(split_at_bounds(rng.bypass_change_detection(), bounds))
+        .zip(split_at_bounds(cap, &cap_bounds))
+        .collect();
+    let (x, captured, rngs) = (
+        ws.positions.as_slice(),
+        ws.captured.as_slice(),
+        ws.rngs.as_slice(),
+    );
+    run_parts(items, move |p, ((ps, rs), cs)| {
+        let a = bounds[p];
+        for (k, (pk, rk)) in ps.iter_mut().zip(rs.iter_mut()).enumerate() {
+            pk.0 = x[a + k];
+            rk.0.clone_from(&rngs[a + k]);
+        }
+        for (k, ck) in cs.iter_mut().enumerate() {
+            ck.0 = captured[a + k];
+        }
+    });
+    true
+}
 
 /// Call `f(k, item)` while the query's items come in the order of `entities` (the usual case:
 /// particles spawned in `ParticleId` order share one table); returns how many matched, so the

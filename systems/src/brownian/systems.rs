@@ -23,9 +23,10 @@
 //! `tests/it/brownian_pipeline.rs`). Positions, capture flags and random streams are
 //! written back at every step.
 //!
-//! **Threads.** The numerical kernels run on the rayon pool; the component passes (writing the
-//! forces, reading `NetForce` back, the write-back) run on the system's thread
-//! ([`super::passes`] says why). Every kernel writes each particle's own value, so the
+//! **Threads.** The numerical kernels run on the rayon pool, the fixed step's phases over one
+//! split of the particles ([`super::parts`]); the write-back too when the particles fill one
+//! table, the other component passes on the system's thread ([`super::passes`]). Every kernel
+//! writes each particle's own value, so the
 //! trajectory is bitwise the same for any thread count (tested in
 //! `tests/it/brownian_pipeline.rs`).
 
@@ -39,12 +40,15 @@ use super::fibre_flow::{FibreFlow, FlowFibre};
 use super::hydro::{Mobility, MobilityMethod, MobilityOptions, auto_method};
 use super::model::{ForceModel, PairLists, ParticleView};
 use super::pair::Mie;
+use super::stepper::advance;
 use super::stepper::multirate::advance_multirate;
-use super::stepper::{PARTICLE_CHUNK, advance};
 use crate::field::CylinderSource;
 use crate::forces::{ExternalForces, ForceComponents, ForceRegistry};
 
-use super::passes::{in_workspace_order, write_dense};
+use super::parts::part_bounds;
+use super::passes::{
+    PositionRows, StreamRows, in_workspace_order, write_back_in_parts, write_dense,
+};
 use magsep_components::forces::KernelForce;
 
 /// Dense state of the run in `ParticleId` order (a resource; authoritative during a run, copied
@@ -524,26 +528,19 @@ pub fn integrate_brownian(
     ws.positions = x;
 }
 
-/// The particles' positions and capture flags (those with a random stream, like the
-/// workspace's).
-type PositionRows<'w, 's> = Query<
-    'w,
-    's,
-    (Entity, &'static mut Position, Option<&'static mut Captured>),
-    With<ParticleRng>,
->;
-/// The particles' random streams.
-type StreamRows<'w, 's> = Query<'w, 's, (Entity, &'static mut ParticleRng), With<Position>>;
-
-/// Copy positions, capture flags and random streams to the components: two passes over
-/// disjoint components, side by side on two threads from [`PARTICLE_CHUNK`] particles (each
-/// is a plain copy, so the split changes nothing but the time).
+/// Copy positions, capture flags and random streams to the components: in the parts of the
+/// step ([`write_back_in_parts`]) when the particles fill one table in workspace order, else
+/// one pass per component (each is a plain copy, so the split changes nothing but the time).
 pub fn write_back_brownian(
     ws: Res<BrownianWorkspace>,
     mut q: PositionRows,
     mut streams: StreamRows,
 ) {
     let ws = &*ws;
+    let bounds = part_bounds(&ws.lists, ws.entities.len());
+    if bounds.len() > 2 && write_back_in_parts(ws, &bounds, &mut q, &mut streams) {
+        return;
+    }
     let positions = |q: &mut PositionRows| {
         let write = |k: usize, mut p: Mut<Position>, c: Option<Mut<Captured>>| {
             p.0 = ws.positions[k];
@@ -572,12 +569,8 @@ pub fn write_back_brownian(
             }
         }
     };
-    if ws.entities.len() >= 2 * PARTICLE_CHUNK {
-        rayon::join(|| positions(&mut q), || rngs(&mut streams));
-    } else {
-        positions(&mut q);
-        rngs(&mut streams);
-    }
+    positions(&mut q);
+    rngs(&mut streams);
 }
 
 /// Whether this step samples the capture curve: every `observe_every` completed steps and the

@@ -148,6 +148,32 @@ impl VerletList {
     /// Whether the list serves configuration `x` with exerting mask `exerts` for pairs closer
     /// than `range` \[m\].
     pub fn serves(&self, x: &[DVec3], exerts: &[bool], range: f64) -> bool {
+        self.serves_checked(x, exerts, range, None)
+    }
+
+    /// Whether the particles `a..b` of `x` are within half the skin of their positions at the
+    /// build (the displacement part of [`VerletList::serves`], for one part of the particles;
+    /// false when `x` is not the built configuration's length).
+    pub fn within_skin(&self, x: &[DVec3], a: usize, b: usize) -> bool {
+        if x.len() != self.reference.len() || b > x.len() || a > b {
+            return false;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        x[a..b]
+            .iter()
+            .zip(&self.reference[a..b])
+            .all(|(p, q)| (*p - *q).length_squared() <= limit)
+    }
+
+    /// [`VerletList::serves`] with the displacement test already done (`within`: the
+    /// [`VerletList::within_skin`] of every part), or done here (None).
+    fn serves_checked(
+        &self,
+        x: &[DVec3],
+        exerts: &[bool],
+        range: f64,
+        within: Option<bool>,
+    ) -> bool {
         if self.rebuild_always
             || self.builds == 0
             || range > self.range
@@ -155,6 +181,9 @@ impl VerletList {
             || exerts != self.exerts.as_slice()
         {
             return false;
+        }
+        if let Some(within) = within {
+            return within;
         }
         let limit = 0.25 * self.skin * self.skin;
         // NaN displacements fail the test, so a broken configuration is rebinned (and its
@@ -179,7 +208,20 @@ impl VerletList {
     /// without a rebuild. Either list holds every pair within `range`, in ascending order, so
     /// the pair sums are bitwise the same whichever serves.
     pub fn ensure(&mut self, x: &[DVec3], exerts: &[bool], range: f64, skin: f64) -> bool {
-        if self.serves(x, exerts, range) {
+        self.ensure_checked(x, exerts, range, skin, None)
+    }
+
+    /// [`VerletList::ensure`] with the displacement test of the current list already done
+    /// (`within`, see [`VerletList::within_skin`]; None: done here).
+    pub fn ensure_checked(
+        &mut self,
+        x: &[DVec3],
+        exerts: &[bool],
+        range: f64,
+        skin: f64,
+        within: Option<bool>,
+    ) -> bool {
+        if self.serves_checked(x, exerts, range, within) {
             self.served += 1;
             return false;
         }
@@ -311,6 +353,18 @@ impl VerletList {
         self.range = range;
         self.skin = skin;
         self.builds += 1;
+    }
+
+    /// List entries of the particles `0..i` (those of every particle for `i` past the end; 0
+    /// before the first build).
+    pub fn entries_before(&self, i: usize) -> u64 {
+        let last = self.starts.len().saturating_sub(1);
+        self.starts.get(i.min(last)).copied().unwrap_or(0) as u64
+    }
+
+    /// Pairs owned by the particles `0..i` (as [`VerletList::entries_before`]).
+    pub fn owned_before(&self, i: usize) -> u64 {
+        self.owned_range(0, i).end as u64
     }
 
     /// Number of pair slots.
