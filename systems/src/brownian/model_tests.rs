@@ -3,13 +3,32 @@ use super::*;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
+/// `n` positions uniform in the cube `[0, edge]^3` \[m\].
+fn positions_in_box(rng: &mut Xoshiro256PlusPlus, n: usize, edge: f64) -> Vec<DVec3> {
+    (0..n)
+        .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * edge)
+        .collect()
+}
+
+/// A force model in the uniform field `b_ext` \[T\] (no fibres), kT = 4e-21 J, with the
+/// contact law `mie` and the dipole cut-off `cutoff` (mean radii).
+fn uniform_field_model(b_ext: DVec3, mie: Option<Mie>, cutoff: f64) -> ForceModel {
+    ForceModel {
+        sources: Vec::new(),
+        b_ext,
+        tolerance: 1e-6,
+        kt: 4e-21,
+        mie,
+        dipole_cutoff: Some(cutoff),
+        field_patch: None,
+    }
+}
+
 #[test]
 fn the_pair_kernel_equals_the_direct_sums() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     let n = 900;
-    let x: Vec<DVec3> = (0..n)
-        .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 4e-6)
-        .collect();
+    let x = positions_in_box(&mut rng, n, 4e-6);
     let radii: Vec<f64> = (0..n).map(|i| [75e-9, 100e-9, 50e-9][i % 3]).collect();
     let moments: Vec<DVec3> = (0..n)
         .map(|i| {
@@ -21,15 +40,7 @@ fn the_pair_kernel_equals_the_direct_sums() {
         })
         .collect();
     let laws = vec![MomentModel::default(); n];
-    let model = ForceModel {
-        sources: Vec::new(),
-        b_ext: DVec3::X,
-        tolerance: 1e-6,
-        kt: 4e-21,
-        mie: None,
-        dipole_cutoff: Some(12.0),
-        field_patch: None,
-    };
+    let model = uniform_field_model(DVec3::X, None, 12.0);
     // captured particles that keep interacting, and ones that do not
     let mobile: Vec<bool> = (0..n).map(|i| i % 7 != 2).collect();
     // one `PairLists` for all three passes: the per-pair buffer is reused with another
@@ -69,18 +80,12 @@ fn cached_lists_give_the_forces_of_fresh_lists_bit_for_bit() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
     let n = 600;
     let a = 75e-9;
-    let mut x: Vec<DVec3> = (0..n)
-        .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 3e-6)
-        .collect();
-    let model = ForceModel {
-        sources: Vec::new(),
-        b_ext: DVec3::new(0.3, 0.0, 1.0),
-        tolerance: 1e-6,
-        kt: 4e-21,
-        mie: Some(Mie::new(4e-19, 30.0, 15.0)),
-        dipole_cutoff: Some(10.0),
-        field_patch: None,
-    };
+    let mut x = positions_in_box(&mut rng, n, 3e-6);
+    let model = uniform_field_model(
+        DVec3::new(0.3, 0.0, 1.0),
+        Some(Mie::new(4e-19, 30.0, 15.0)),
+        10.0,
+    );
     let laws = vec![MomentModel::Saturated { moment: 1e-16 }; n];
     let (radii, mobile) = (vec![a; n], vec![true; n]);
     let view = ParticleView {
@@ -118,18 +123,12 @@ fn the_fused_pair_pass_equals_the_separate_passes_bit_for_bit() {
     let n = 1500;
     let a = 75e-9;
     // dense enough for contacts (Mie range 2.1 a) and many dipole pairs
-    let x: Vec<DVec3> = (0..n)
-        .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.2e-6)
-        .collect();
-    let model = ForceModel {
-        sources: Vec::new(),
-        b_ext: DVec3::new(0.2, 0.0, 1.0),
-        tolerance: 1e-6,
-        kt: 4e-21,
-        mie: Some(Mie::new(4e-21, 12.0, 6.0)),
-        dipole_cutoff: Some(8.0),
-        field_patch: None,
-    };
+    let x = positions_in_box(&mut rng, n, 2.2e-6);
+    let model = uniform_field_model(
+        DVec3::new(0.2, 0.0, 1.0),
+        Some(Mie::new(4e-21, 12.0, 6.0)),
+        8.0,
+    );
     let laws = vec![MomentModel::Saturated { moment: 1e-17 }; n];
     let radii = vec![a; n];
     let mobile: Vec<bool> = (0..n).map(|i| i % 13 != 6).collect();
