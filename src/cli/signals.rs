@@ -1,5 +1,6 @@
-//! SIGINT and SIGTERM during `magsep run` (the handlers are installed by the CLI only; the
-//! library's side is the [`StopFlag`]).
+//! SIGINT and SIGTERM during `magsep run` and `magsep sweep` (the handlers are installed by the
+//! CLI only; the library's side is the [`StopFlag`]; a sweep stops as described in
+//! `studies::sweep::run`).
 //!
 //! The first signal sets the run's stop flag: the current step ends, the final frame is
 //! recorded, the recording is closed with its footer and a `magsep.interrupted` record, the

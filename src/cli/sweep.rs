@@ -186,6 +186,10 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 Some(j) => j.min(super::run::MAX_THREADS),
                 None => std::thread::available_parallelism().map_or(1, |n| n.get()),
             };
+            let stop = crate::sim::StopFlag::new();
+            let signals = super::signals::install(&stop).map_err(|e| {
+                CliError::runtime(format!("cannot install the signal handlers: {e}"))
+            })?;
             let progress = StderrProgress::new(cmd.quiet, "points");
             let bar = progress.bar();
             bar.set_style(
@@ -203,11 +207,24 @@ pub fn sweep(ext: &Extensions, cmd: SweepCommand) -> Result<(), CliError> {
                 retry_failed: cmd.retry_failed,
                 memory_budget: crate::scene::memory::budget(cmd.memory_budget)
                     .map_err(CliError::input)?,
+                stop: Some(stop),
             };
             let result = sweep::run_sweep(&args, &ext.registry, ext.plugins.clone(), bar);
             drop(progress);
             let result = result.map_err(to_cli)?;
             print(pretty(&result))?;
+            if result["interrupted"] == true
+                && let Some(code) = signals.exit_code()
+            {
+                return Err(CliError {
+                    code,
+                    message: format!(
+                        "interrupted by {}: {}",
+                        result["interrupted_by"].as_str().unwrap_or("a signal"),
+                        result["resume"].as_str().unwrap_or_default()
+                    ),
+                });
+            }
             let failed = result["failed"]
                 .as_u64()
                 .unwrap_or(result["failed_now"].as_u64().unwrap_or(0));

@@ -32,4 +32,5 @@ mod spheroid_collisions;
 mod spheroids;
 mod sweep_curves;
 mod sweep_memory;
+mod sweep_signals;
 mod sweeps;

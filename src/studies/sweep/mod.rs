@@ -55,6 +55,8 @@ pub struct SweepRun {
     pub retry_failed: bool,
     /// Memory budget \[bytes\] of the points running at once.
     pub memory_budget: u64,
+    /// Stop gracefully when set (the CLI sets it on SIGINT / SIGTERM): see [`Runner::stop`].
+    pub stop: Option<crate::sim::StopFlag>,
 }
 
 /// Load and validate `path` (the sweep file): bad input at its key path.
@@ -169,11 +171,13 @@ pub fn run_sweep(
         plugins,
         out: &args.out,
         record: args.record,
+        stop: args.stop.clone(),
     };
-    let failed = runner
+    let ran = runner
         .run_all(&todo, jobs, &|| bar.inc(1))
         .map_err(SweepError::Runtime)?;
     bar.finish_and_clear();
+    let stopped_by = (args.stop.as_ref()).and_then(crate::sim::StopFlag::reason);
     let seconds = started.elapsed().as_secs_f64();
     let mut out = json!({
         "sweep": args.sweep.display().to_string(),
@@ -181,17 +185,28 @@ pub fn run_sweep(
         "points": sweep.len(),
         "shard": args.shard.map(|(i, n)| format!("{i}/{n}")),
         "shard_points": mine.len(),
-        "ran": todo.len(),
+        "ran": ran.finished,
         "skipped": mine.len() - todo.len(),
-        "failed_now": failed,
+        "failed_now": ran.failed,
         "jobs": jobs,
         "jobs_limited_by_memory": jobs < args.jobs.min(todo.len()),
         "largest_point_memory_estimate_bytes": largest.round() as u64,
         "memory_budget_bytes": args.memory_budget,
         "wall_time_s": seconds,
-        "points_per_second": todo.len() as f64 / seconds.max(1e-9),
+        "points_per_second": ran.finished as f64 / seconds.max(1e-9),
     });
-    if args.shard.is_none() {
+    if let Some(reason) = stopped_by {
+        // no table: the same command finishes the sweep; `merge` tabulates what is done
+        out["interrupted"] = json!(true);
+        out["interrupted_by"] = json!(reason);
+        out["unfinished"] = json!(todo.len() - ran.finished);
+        out["resume"] = json!(format!(
+            "run the same command again to finish the {} unfinished points \
+             (`magsep sweep merge {}` tabulates the finished ones)",
+            todo.len() - ran.finished,
+            args.out.display()
+        ));
+    } else if args.shard.is_none() {
         let results = finish(&sweep, &args.out)?;
         if let (Value::Object(a), Value::Object(b)) = (&mut out, results) {
             a.extend(b);

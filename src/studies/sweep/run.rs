@@ -1,6 +1,7 @@
 //! Running a sweep's points: in-process runs on `jobs` worker threads, each point's directory
 //! written to a temporary name and renamed when complete, so a killed sweep restarted skips
-//! the finished points and redoes the rest.
+//! the finished points and redoes the rest; a stop flag (SIGINT / SIGTERM in the CLI) ends
+//! it gracefully, dropping the points cut short.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -15,7 +16,7 @@ use toml_edit::DocumentMut;
 use super::file::{Point, Sweep, value_cell};
 use crate::scene::overrides::{apply_to_document, parse_document};
 use crate::scene::{NoProgress, Registry, RunOptions, Scene, SceneErrors, parse_scene};
-use crate::sim::{SimError, Simulation, run_scene};
+use crate::sim::{SimError, Simulation, StopFlag, run_scene};
 
 /// Name of the manifest in a sweep directory.
 pub const MANIFEST: &str = "sweep.json";
@@ -356,14 +357,40 @@ pub struct Runner<'a> {
     pub out: &'a Path,
     /// Write each point's recording (`recording.mcap`).
     pub record: bool,
+    /// Stop the sweep gracefully when set (e.g. by SIGINT): no new point starts, and the points
+    /// running are stopped at their current step and left unfinished (their `.tmp-N`
+    /// directories removed), so that a restart runs them again from the start.
+    pub stop: Option<StopFlag>,
+}
+
+/// How [`Runner::run_point`] left a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointEnd {
+    /// Finished without error (its directory is in place).
+    Ok,
+    /// Finished with an error (recorded in its `error.json`).
+    Failed,
+    /// Stopped by the sweep's stop flag before it finished: nothing is kept.
+    Interrupted,
+}
+
+/// What [`Runner::run_all`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunAll {
+    /// Points that finished with an error.
+    pub failed: usize,
+    /// Points that finished (with or without an error).
+    pub finished: usize,
+    /// Points stopped part-way by the stop flag (left to a restart).
+    pub interrupted: usize,
 }
 
 impl Runner<'_> {
-    /// Run point `index` into its directory; `Ok(true)` if it finished without error.
+    /// Run point `index` into its directory.
     ///
     /// # Errors
     /// An I/O failure of the sweep directory (the run's own failures are the point's error).
-    pub fn run_point(&self, base: &DocumentMut, index: usize) -> Result<bool, String> {
+    pub fn run_point(&self, base: &DocumentMut, index: usize) -> Result<PointEnd, String> {
         let point = self.sweep.point(index);
         let tmp = self.out.join("points").join(format!(".tmp-{index}"));
         let io = |e: std::io::Error| format!("{}: {e}", tmp.display());
@@ -387,6 +414,7 @@ impl Runner<'_> {
                 record: self.record.then(|| tmp.join("recording.mcap")),
                 single_threaded: true,
                 plugins: self.plugins.clone(),
+                stop: self.stop.as_ref().map(StopFlag::child),
                 forces_unread: true,
                 ..Default::default()
             };
@@ -400,6 +428,12 @@ impl Runner<'_> {
         };
         let (summary, error) = catch_unwind(AssertUnwindSafe(run))
             .unwrap_or_else(|p| (None, Some(format!("panicked: {}", panic_message(&*p)))));
+        let stopped = self.stop.as_ref().is_some_and(StopFlag::is_stopped);
+        if stopped && summary.as_ref().is_none_or(|s| s["interrupted"] == true) {
+            // cut short by the sweep's stop: not a result; a restart runs it again
+            std::fs::remove_dir_all(&tmp).map_err(io)?;
+            return Ok(PointEnd::Interrupted);
+        }
         if let Some(s) = &summary {
             std::fs::write(tmp.join("summary.json"), pretty(s)).map_err(io)?;
         }
@@ -409,11 +443,15 @@ impl Runner<'_> {
         let dir = point_dir(self.out, index);
         std::fs::rename(&tmp, &dir)
             .map_err(|e| format!("cannot move {} to {}: {e}", tmp.display(), dir.display()))?;
-        Ok(error.is_none())
+        Ok(if error.is_none() {
+            PointEnd::Ok
+        } else {
+            PointEnd::Failed
+        })
     }
 
-    /// Run `todo` on `jobs` worker threads, calling `done` after each point; returns the
-    /// number of failed points.
+    /// Run `todo` on `jobs` worker threads, calling `done` after each finished point; once
+    /// the stop flag is set no new point starts.
     ///
     /// # Errors
     /// The first I/O failure of the sweep directory (the workers stop taking new points).
@@ -422,10 +460,12 @@ impl Runner<'_> {
         todo: &[usize],
         jobs: usize,
         done: &(dyn Fn() + Sync),
-    ) -> Result<usize, String> {
+    ) -> Result<RunAll, String> {
         let base = base_document(self.sweep).map_err(|e| e.to_string())?;
         let next = AtomicUsize::new(0);
         let failed = AtomicUsize::new(0);
+        let finished = AtomicUsize::new(0);
+        let interrupted = AtomicUsize::new(0);
         let io_error: Mutex<Option<String>> = Mutex::new(None);
         std::thread::scope(|s| {
             for _ in 0..jobs.clamp(1, todo.len().max(1)) {
@@ -433,13 +473,22 @@ impl Runner<'_> {
                     loop {
                         let k = next.fetch_add(1, Ordering::Relaxed);
                         let Some(&index) = todo.get(k) else { break };
-                        if io_error.lock().map(|e| e.is_some()).unwrap_or(true) {
+                        if io_error.lock().map(|e| e.is_some()).unwrap_or(true)
+                            || self.stop.as_ref().is_some_and(StopFlag::is_stopped)
+                        {
                             break;
                         }
                         match self.run_point(&base, index) {
-                            Ok(true) => {}
-                            Ok(false) => {
+                            Ok(PointEnd::Ok) => {
+                                finished.fetch_add(1, Ordering::Relaxed);
+                            }
+                            Ok(PointEnd::Failed) => {
+                                finished.fetch_add(1, Ordering::Relaxed);
                                 failed.fetch_add(1, Ordering::Relaxed);
+                            }
+                            Ok(PointEnd::Interrupted) => {
+                                interrupted.fetch_add(1, Ordering::Relaxed);
+                                break;
                             }
                             Err(e) => {
                                 if let Ok(mut slot) = io_error.lock() {
@@ -455,7 +504,11 @@ impl Runner<'_> {
         });
         match io_error.into_inner().ok().flatten() {
             Some(e) => Err(e),
-            None => Ok(failed.into_inner()),
+            None => Ok(RunAll {
+                failed: failed.into_inner(),
+                finished: finished.into_inner(),
+                interrupted: interrupted.into_inner(),
+            }),
         }
     }
 }
