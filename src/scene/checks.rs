@@ -307,6 +307,16 @@ pub fn within(errors: &mut Vec<SceneError>, path: &str, v: f64, lo: f64, hi: f64
     });
 }
 
+/// A derived number for a message, to 4 significant digits: plain between 1e-3 and 1e6,
+/// scientific outside (a value the user wrote is shown as written, with [`num`]).
+pub fn num4(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let rounded: f64 = format!("{v:.3e}").parse().unwrap_or(v);
+    num(rounded)
+}
+
 /// A number for a message: plain between 1e-3 and 1e6, scientific outside.
 pub fn num(v: f64) -> String {
     if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {

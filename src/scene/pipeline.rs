@@ -306,6 +306,13 @@ pub trait Pipeline: Send + Sync + 'static {
         &[]
     }
 
+    /// Whether the pipeline's physics uses `[[fibres]]`, `[[fibre_packings]]` and
+    /// `[external_field]`. A scene giving them to a pipeline that does not is refused at those
+    /// keys (exit 2), not run without them. Default `true` (a plugin may read them).
+    fn uses_fibres(&self) -> bool {
+        true
+    }
+
     /// `[[particles]]` keys this pipeline reads beyond `count` and `shape` (a plugin
     /// pipeline's own keys arrive in [`ParticleGroup::extra`]).
     fn particle_keys(&self) -> &'static [&'static str] {

@@ -450,6 +450,21 @@ pub fn parse_and_validate(text: &str, registry: &Registry) -> Result<Scene, Vec<
                 ),
             ));
         }
+        if !p.uses_fibres() {
+            for key in ["fibres", "fibre_packings", "external_field"] {
+                if table.contains_key(key) {
+                    errors.push(SceneError::new(
+                        key,
+                        format!(
+                            "the {} pipeline does not use magnetised fibres or an applied field: \
+                             a run would ignore them; remove this key (`magsep field` computes \
+                             the field of a scene with only fibres and the applied field)",
+                            p.name()
+                        ),
+                    ));
+                }
+            }
+        }
         let mut cx = ParseContext {
             fibres_valid,
             table: &table,

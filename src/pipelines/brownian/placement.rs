@@ -93,6 +93,17 @@ pub fn spawn_brownian(
                     break;
                 }
             }
+            if explicit
+                && let Some(p) = found
+                && let Some(j) = sources.iter().position(|s| s.distance(p) <= a)
+            {
+                // it would count as captured from the start
+                return Err(SpawnError::Other(format!(
+                    "particles[{g}].placement.positions[{k}]: {:?} m is inside fibre {j} or \
+                     closer to its surface than the particle radius {a:e} m",
+                    p.to_array()
+                )));
+            }
             let Some(p) = found else {
                 return Err(SpawnError::Other(format!(
                     "particles[{g}]: no overlap-free place for particle {k} after {MAX_ATTEMPTS} \

@@ -11,7 +11,7 @@ use magsep_components::packing::OverlapRemovalScheme;
 use magsep_components::shape::Shape;
 
 use super::scene::{ContainerSpec, PackingSection};
-use crate::scene::checks::{check, finite_positive, num};
+use crate::scene::checks::{check, finite_positive, num, num4};
 use crate::scene::{ParticleGroup, SceneError, ShapeSpec};
 
 fn is_superquadric(s: &ShapeSpec) -> bool {
@@ -133,6 +133,88 @@ pub(crate) fn validate(
         }
         Some(ContainerSpec::PeriodicBox {}) | Some(ContainerSpec::ClosedBox {}) | None => {}
     }
+    if errors.is_empty() {
+        start_size(
+            container,
+            groups,
+            &shapes,
+            packing,
+            needed,
+            largest_bound,
+            errors,
+        );
+    }
+}
+
+/// The start container must hold the largest particle: a box's edge its bounding diameter (in a
+/// periodic box, a particle and its own image apart; the random insertion would otherwise try
+/// its 10^6 places against hundreds of images each), the compressed length of a cylinder,
+/// wedge or slab the particle's width across (`needed`, a radius).
+fn start_size(
+    container: Option<&ContainerSpec>,
+    groups: &[&ParticleGroup],
+    shapes: &[Shape],
+    packing: &PackingSection,
+    needed: f64,
+    largest_bound: f64,
+    errors: &mut Vec<SceneError>,
+) {
+    let phi0 = packing.initial_packing_fraction.unwrap_or(0.05);
+    let volume: f64 = (groups.iter().zip(shapes))
+        .map(|(g, s)| g.count as f64 * magsep_systems::geometry::volume(s))
+        .sum();
+    let spec = container.cloned().unwrap_or(ContainerSpec::PeriodicBox {});
+    let boxed = matches!(
+        spec,
+        ContainerSpec::PeriodicBox {} | ContainerSpec::ClosedBox {}
+    );
+    let edges = start_container(&spec, volume, phi0).edges();
+    // the compressed dimension: every edge of a box, z of the others
+    let (length, width) = if boxed {
+        (edges.min_element(), 2.0 * largest_bound)
+    } else {
+        (edges.z, 2.0 * needed)
+    };
+    if !(volume > 0.0 && length.is_finite()) || length > width {
+        return;
+    }
+    // the packing fraction at which the start length equals the width
+    let phi_max = if boxed {
+        volume / width.powi(3)
+    } else {
+        phi0 * length / width
+    };
+    let (key, what) = match spec {
+        ContainerSpec::PeriodicBox {} | ContainerSpec::ClosedBox {} => {
+            ("packing.initial_packing_fraction", "box edge")
+        }
+        ContainerSpec::Cylinder { .. } => ("container.radius", "cylinder length"),
+        ContainerSpec::Wedge { .. } => ("container.length", "wedge length"),
+        ContainerSpec::Slab { .. } => ("container.side", "slab height"),
+    };
+    let lower = format!(
+        "lower packing.initial_packing_fraction below {}",
+        num4(phi_max)
+    );
+    let advice = match (phi_max >= 1e-3, boxed) {
+        (true, true) => format!("{lower}, or use more particles"),
+        (false, true) => "use more particles (at the lowest initial_packing_fraction, 1e-3, \
+                          the box is still too small)"
+            .to_string(),
+        (true, false) => format!("{lower}, or give a smaller cross-section"),
+        (false, false) => "give a smaller cross-section or more particles".to_string(),
+    };
+    errors.push(SceneError::new(
+        key,
+        format!(
+            "at initial_packing_fraction {} the start {what} is {} m, not more than the \
+             largest particle's {} {} m: it cannot hold it; {advice}",
+            num(phi0),
+            num4(length),
+            if boxed { "bounding diameter" } else { "width" },
+            num4(width),
+        ),
+    ));
 }
 
 /// The start container for `particle_volume` [m^3] at packing fraction `phi0`.

@@ -39,6 +39,10 @@ impl Pipeline for PackingPipeline {
         crate::scene::memory::MemoryEstimate::per_particle(scene, 4096.0 + per_cell)
     }
 
+    fn uses_fibres(&self) -> bool {
+        false
+    }
+
     fn description(&self) -> &'static str {
         "random dense packings by mechanical contraction"
     }

@@ -58,6 +58,10 @@ impl Pipeline for ParticleFluidPipeline {
         estimate
     }
 
+    fn uses_fibres(&self) -> bool {
+        false
+    }
+
     fn description(&self) -> &'static str {
         "inertial particles levitating and colliding in a magnetised liquid"
     }

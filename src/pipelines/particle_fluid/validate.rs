@@ -3,6 +3,7 @@
 //! `volume_fraction`.
 
 use glam::DVec3;
+use magsep_systems::collision::restitution::CollisionModelError;
 use magsep_systems::fluid::config::HistoryChoice;
 use magsep_systems::fluid::flow::FlowModel;
 
@@ -195,8 +196,16 @@ pub fn validate(
             );
         }
     }
-    if let Err(e) = pf.collisions.model(&pf.liquid).validate() {
-        errors.push(SceneError::new("collisions", e.to_string()));
+    for e in pf.collisions.model(&pf.liquid).violations() {
+        let CollisionModelError::OutOfRange { name, value, range } = e;
+        // the liquid's density and viscosity enter the model too: `[liquid]`'s own checks
+        // report them at their keys
+        if !matches!(name, "fluid_density" | "kinematic_viscosity") {
+            errors.push(SceneError::new(
+                format!("collisions.{name}"),
+                format!("must be in {range}, got {}", num(value)),
+            ));
+        }
     }
     let edges = pf.container.edges();
     let bounded = !matches!(pf.container, FluidContainerSpec::Unbounded {});
@@ -379,6 +388,27 @@ fn validate_group(
                     format!("{q}.max"),
                     format!("must exceed min on every axis, got min {min:?}, max {max:?}"),
                 ));
+            } else if bounded {
+                // the centres are drawn in the box: as for points, a particle clear of the walls
+                let tol = 1e-12 * edges.max_element();
+                for (key, corner, ok) in [
+                    ("min", min, (0..3).all(|a| min[a] >= radius - tol)),
+                    (
+                        "max",
+                        max,
+                        (0..3).all(|a| max[a] <= edges[a] - radius + tol),
+                    ),
+                ] {
+                    check(errors, ok, &format!("{q}.{key}"), || {
+                        let r = crate::scene::checks::num(radius);
+                        format!(
+                            "the start box must lie inside the container, a particle radius clear \
+                             of the walls (every coordinate in [{r}, edge - {r}] m, edges {:?} m), \
+                             got {corner:?}",
+                            edges.to_array()
+                        )
+                    });
+                }
             }
         }
         Some(PlacementSpec::Points { positions }) => {

@@ -247,51 +247,60 @@ impl CollisionModel {
         }
     }
 
-    /// Checks every parameter against its documented range.
+    /// Checks every parameter against its documented range (the first violation; see
+    /// [`violations`](Self::violations) for all of them).
     pub fn validate(&self) -> Result<(), CollisionModelError> {
+        match self.violations().first() {
+            Some(e) => Err(*e),
+            None => Ok(()),
+        }
+    }
+
+    /// Every parameter outside its documented range, in declaration order.
+    pub fn violations(&self) -> Vec<CollisionModelError> {
         let unit = |x: f64| (0.0..=1.0).contains(&x);
-        match self.restitution {
+        let positive = |x: f64| x > 0.0 && x.is_finite();
+        let non_negative = |x: f64| x >= 0.0 && x.is_finite();
+        let mut checks: Vec<(&'static str, f64, bool, &'static str)> = match self.restitution {
             Restitution::Dry { normal } => {
-                check("restitution.normal", normal, unit(normal), "[0, 1]")?
+                vec![("restitution.normal", normal, unit(normal), "[0, 1]")]
             }
             Restitution::Wet {
                 dry_normal,
                 roughness,
-            } => {
-                check(
+            } => vec![
+                (
                     "restitution.dry_normal",
                     dry_normal,
                     unit(dry_normal),
                     "[0, 1]",
-                )?;
-                check(
+                ),
+                (
                     "restitution.roughness",
                     roughness,
-                    roughness > 0.0 && roughness.is_finite(),
+                    positive(roughness),
                     "(0, ∞)",
-                )?;
-            }
-        }
-        let et = self.tangential_restitution;
-        check(
-            "tangential_restitution",
-            et,
-            (-1.0..=1.0).contains(&et),
-            "[-1, 1]",
-        )?;
-        let mu = self.friction;
-        check("friction", mu, mu >= 0.0 && mu.is_finite(), "[0, ∞)")?;
-        let v = self.rest_speed;
-        check("rest_speed", v, v >= 0.0 && v.is_finite(), "[0, ∞)")?;
-        let rho = self.fluid_density;
-        check("fluid_density", rho, rho > 0.0 && rho.is_finite(), "(0, ∞)")?;
-        let nu = self.kinematic_viscosity;
-        check(
-            "kinematic_viscosity",
-            nu,
-            nu > 0.0 && nu.is_finite(),
-            "(0, ∞)",
-        )
+                ),
+            ],
+        };
+        let (et, mu, v) = (self.tangential_restitution, self.friction, self.rest_speed);
+        let (rho, nu) = (self.fluid_density, self.kinematic_viscosity);
+        checks.extend([
+            (
+                "tangential_restitution",
+                et,
+                (-1.0..=1.0).contains(&et),
+                "[-1, 1]",
+            ),
+            ("friction", mu, non_negative(mu), "[0, ∞)"),
+            ("rest_speed", v, non_negative(v), "[0, ∞)"),
+            ("fluid_density", rho, positive(rho), "(0, ∞)"),
+            ("kinematic_viscosity", nu, positive(nu), "(0, ∞)"),
+        ]);
+        checks
+            .into_iter()
+            .filter_map(|(name, value, ok, range)| check(name, value, ok, range).err())
+            .collect()
     }
 
     /// Whether an approach at `approach_speed` [m/s] counts as a resting contact (fully inelastic).
