@@ -123,11 +123,11 @@ pub fn not_recomputed(summary: &mut Value, keys: &[&str]) {
     for key in keys {
         let mut parts: Vec<&str> = key.split('.').collect();
         let last = parts.pop().unwrap_or_default();
-        let mut node = &mut *summary;
+        let mut node = Some(&mut *summary);
         for p in parts {
-            node = &mut node[p];
+            node = node.and_then(|n| n.get_mut(p));
         }
-        if let Some(obj) = node.as_object_mut() {
+        if let Some(obj) = node.and_then(Value::as_object_mut) {
             obj.insert(last.to_string(), Value::Null);
         }
     }
@@ -156,7 +156,8 @@ fn damage_keys(rec: &Recording, obj: &mut serde_json::Map<String, Value>) {
         .as_ref()
         .filter(|t| rec.damaged.as_ref() != Some(*t));
     if let Some(d) = &rec.damaged {
-        if truncation.is_none() && obj.get("truncated").and_then(Value::as_str) == Some(d) {
+        if truncation.is_none() && obj.get("truncated").and_then(Value::as_str) == Some(d.as_str())
+        {
             obj.remove("truncated");
         }
         obj.entry("damaged").or_insert(Value::String(d.clone()));
