@@ -54,6 +54,8 @@ impl FieldScene {
 /// # Errors
 /// Every bad line, with its line number (one message per line, at most 20).
 pub fn read_points(text: &str) -> Result<Vec<DVec3>, String> {
+    // a leading UTF-8 byte-order mark (Excel writes one) is not part of the header
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -325,6 +327,14 @@ pub fn attractive_force(scene: &FieldScene, p: DVec3, law: &MomentModel) -> f64 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_leading_byte_order_mark_is_accepted() {
+        let points = read_points("\u{feff}x,y,z\r\n1,2,3\r\n").unwrap();
+        assert_eq!(points, vec![DVec3::new(1.0, 2.0, 3.0)]);
+        // elsewhere it is still an error
+        assert!(read_points("x,y,z\n\u{feff}1,2,3\n").is_err());
+    }
 
     fn three_fibres() -> FieldScene {
         let text = std::fs::read_to_string(concat!(

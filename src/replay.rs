@@ -103,13 +103,68 @@ pub fn last_frame(rec: &Recording) -> Result<&ParticleFrame, ReplayError> {
     })
 }
 
-/// The run's wall time \[s\] from the recorded summary (0 when absent).
+/// The run's wall time \[s\] from the recorded summary; NaN (JSON `null`) when the file has
+/// none (a killed run's), which [`replay_with`] then lists in `not_recomputed`.
 pub fn recorded_wall_time(rec: &Recording) -> f64 {
+    recorded_summary_wall_time(rec).unwrap_or(f64::NAN)
+}
+
+fn recorded_summary_wall_time(rec: &Recording) -> Option<f64> {
     rec.summary_json
         .as_deref()
         .and_then(|s| serde_json::from_str::<Value>(s).ok())
         .and_then(|v| v.get("wall_time_s").and_then(Value::as_f64))
-        .unwrap_or(0.0)
+}
+
+/// Marks the values of a replayed `summary` at `keys` (dotted paths, e.g.
+/// `stepper.neighbour_list_builds`) as ones the frames cannot give: each is set to `null`
+/// (where its parent object exists) and appended to the summary's `not_recomputed` list.
+pub fn not_recomputed(summary: &mut Value, keys: &[&str]) {
+    for key in keys {
+        let mut parts: Vec<&str> = key.split('.').collect();
+        let last = parts.pop().unwrap_or_default();
+        let mut node = Some(&mut *summary);
+        for p in parts {
+            node = node.and_then(|n| n.get_mut(p));
+        }
+        if let Some(obj) = node.and_then(Value::as_object_mut) {
+            obj.insert(last.to_string(), Value::Null);
+        }
+    }
+    let Some(obj) = summary.as_object_mut() else {
+        return;
+    };
+    let list = obj
+        .entry("not_recomputed")
+        .or_insert_with(|| Value::Array(Vec::new()));
+    if let Value::Array(list) = list {
+        for key in keys {
+            if !list.iter().any(|v| v == key) {
+                list.push(Value::from(*key));
+            }
+        }
+    }
+}
+
+/// The damage and truncation keys of a replayed summary: `"damaged"` (the reader's message)
+/// when a corrupt record stopped the reading or bytes follow the footer, `"truncated"` only
+/// when the file was cut short. A pipeline's replay that copied the damage under
+/// `"truncated"` (the reader gives a damaged record in both) has that key removed.
+fn damage_keys(rec: &Recording, obj: &mut serde_json::Map<String, Value>) {
+    let truncation = rec
+        .truncated
+        .as_ref()
+        .filter(|t| rec.damaged.as_ref() != Some(*t));
+    if let Some(d) = &rec.damaged {
+        if truncation.is_none() && obj.get("truncated").and_then(Value::as_str) == Some(d.as_str())
+        {
+            obj.remove("truncated");
+        }
+        obj.entry("damaged").or_insert(Value::String(d.clone()));
+    }
+    if let Some(t) = truncation {
+        obj.entry("truncated").or_insert(Value::String(t.clone()));
+    }
 }
 
 /// Replay a recording with the built-in pipelines: the summary of its last frame (same keys
@@ -122,8 +177,10 @@ pub fn replay(path: &Path) -> Result<(Value, Recording), ReplayError> {
 }
 
 /// Replay a recording with the pipelines of `registry`: the pipeline's
-/// [`replay`](crate::scene::Pipeline::replay), with `"truncated"` (what was damaged, as read)
-/// added when the file was cut or damaged and the pipeline did not say so.
+/// [`replay`](crate::scene::Pipeline::replay), with `"truncated"` (where the file was cut)
+/// or `"damaged"` (the reader's message: a corrupt record, bytes after the footer) added
+/// when the pipeline did not say so, and `wall_time_s` `null` and listed in `not_recomputed`
+/// when the file holds no run summary.
 ///
 /// # Errors
 /// [`ReplayError`].
@@ -135,11 +192,13 @@ pub fn replay_with(path: &Path, registry: &Registry) -> Result<(Value, Recording
         ReplayError::Unsupported("the recorded scene is field-only: nothing to replay".into())
     })?;
     let mut summary = pipeline.replay(&rec, &scene, meta.seed)?;
-    // a damaged file says so whatever the pipeline's replay reports
-    if let (Some(t), Some(obj)) = (&rec.truncated, summary.as_object_mut())
-        && !obj.contains_key("truncated")
-    {
-        obj.insert("truncated".into(), Value::String(t.clone()));
+    // a damaged or cut file says so whatever the pipeline's replay reports
+    if let Some(obj) = summary.as_object_mut() {
+        damage_keys(&rec, obj);
+    }
+    // a killed run's file has no summary, so no wall time
+    if summary.get("wall_time_s").is_some() && recorded_summary_wall_time(&rec).is_none() {
+        not_recomputed(&mut summary, &["wall_time_s"]);
     }
     // the registered forces, as the run's summary lists them, from the recording's metadata
     if let Some(obj) = summary.as_object_mut() {

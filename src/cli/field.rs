@@ -1,5 +1,7 @@
-//! `magsep field SCENE --points FILE [--gradient]` and
-//! `magsep field SCENE --slice z=0 --extent ... --out map.svg`.
+//! `magsep field SCENE --points FILE [--gradient] [--out FILE.csv]` and
+//! `magsep field SCENE --slice z=0 --extent ... --out map.svg [--resolution N] [--moment M
+//! [--cutoff F]]`. An option that does not apply to the mode given is refused (exit 2), never
+//! silently ignored.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -28,20 +30,70 @@ pub struct FieldArgs {
     pub slice: Option<String>,
     /// Map extent.
     pub extent: Option<String>,
-    /// Map output.
+    /// Map output (SVG), or the points' CSV instead of stdout.
     pub out: Option<PathBuf>,
-    /// Map resolution (cells per side).
-    pub resolution: usize,
+    /// Map resolution (cells per side; default [`DEFAULT_RESOLUTION`]).
+    pub resolution: Option<usize>,
     /// Map the force on a particle of this saturated moment [A m²] instead of |B|.
     pub moment: Option<f64>,
-    /// Capture cut-off force [N].
-    pub cutoff: f64,
+    /// Capture cut-off force [N] (with `moment`; default [`DEFAULT_CUTOFF`]).
+    pub cutoff: Option<f64>,
     /// Overwrite an existing `out` (never an input).
     pub force: bool,
 }
 
-/// `magsep field` with `threads` worker threads: `--out` is checked before anything runs.
+/// Cells per side of a map when `--resolution` is not given.
+pub const DEFAULT_RESOLUTION: usize = 200;
+/// Capture cut-off force [N] when `--cutoff` is not given (thesis: 0.5e-15 N).
+pub const DEFAULT_CUTOFF: f64 = 0.5e-15;
+
+/// The options given that do not apply to the mode (`--points` or `--slice`), as an error
+/// naming each and why (they would otherwise be ignored).
+fn inapplicable(a: &FieldArgs) -> Result<(), CliError> {
+    const MAP_ONLY: &str = "applies to maps (--slice) only, not to --points";
+    let wrong: Vec<(&str, &str)> = if a.points.is_some() {
+        [
+            (a.extent.is_some(), "--extent"),
+            (a.resolution.is_some(), "--resolution"),
+            (a.moment.is_some(), "--moment"),
+            (a.cutoff.is_some(), "--cutoff"),
+        ]
+        .into_iter()
+        .filter(|w| w.0)
+        .map(|w| (w.1, MAP_ONLY))
+        .collect()
+    } else if a.slice.is_some() {
+        [
+            (a.gradient, "--gradient", "applies to --points only"),
+            (
+                a.cutoff.is_some() && a.moment.is_none(),
+                "--cutoff",
+                "is the capture contour of a force map: it needs --moment",
+            ),
+        ]
+        .into_iter()
+        .filter(|w| w.0)
+        .map(|w| (w.1, w.2))
+        .collect()
+    } else {
+        Vec::new()
+    };
+    if wrong.is_empty() {
+        return Ok(());
+    }
+    let lines: Vec<String> = (wrong.iter())
+        .map(|(name, why)| format!("{name} {why}"))
+        .collect();
+    Err(CliError::input(format!(
+        "options that would be ignored: {}",
+        lines.join("; ")
+    )))
+}
+
+/// `magsep field` with `threads` worker threads: the options and `--out` are checked before
+/// anything runs.
 pub fn field(a: FieldArgs, threads: Option<usize>) -> Result<(), CliError> {
+    inapplicable(&a)?;
     let text = super::run::scene_text(&a.scene)?;
     if let Some(out) = &a.out {
         let mut inputs = super::run::scene_inputs(&a.scene, &text);
@@ -61,7 +113,7 @@ pub fn field(a: FieldArgs, threads: Option<usize>) -> Result<(), CliError> {
     }
     let fs = FieldScene::from_scene(&scene);
     match (&a.points, &a.slice) {
-        (Some(points), None) => points_csv(&fs, points, a.gradient),
+        (Some(points), None) => points_csv(&fs, points, a.gradient, a.out.as_deref()),
         (None, Some(slice)) => map(&fs, &a, slice),
         _ => Err(CliError::input(
             "give either --points FILE or --slice AXIS=VALUE (with --extent and --out)",
@@ -69,21 +121,37 @@ pub fn field(a: FieldArgs, threads: Option<usize>) -> Result<(), CliError> {
     }
 }
 
-fn points_csv(fs: &FieldScene, path: &Path, gradient: bool) -> Result<(), CliError> {
+/// The field at the points of the CSV at `path`, as CSV on stdout, or into `file` (checked
+/// by the caller: never an input) with a JSON line on stdout.
+fn points_csv(
+    fs: &FieldScene,
+    path: &Path,
+    gradient: bool,
+    file: Option<&Path>,
+) -> Result<(), CliError> {
     let text = read_text(path, MAX_POINTS_BYTES).map_err(CliError::input)?;
     let points =
         read_points(&text).map_err(|e| CliError::input(format!("{}:\n{e}", path.display())))?;
     let rows = field_rows(fs, &points, gradient);
-    let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::new(stdout.lock());
-    let mut write = || -> std::io::Result<()> {
+    let write = |out: &mut dyn Write| -> std::io::Result<()> {
         writeln!(out, "{}", csv_header(gradient))?;
         for r in &rows {
             writeln!(out, "{r}")?;
         }
         out.flush()
     };
-    write().map_err(stdout_error)
+    let Some(file) = file else {
+        let stdout = std::io::stdout();
+        return write(&mut std::io::BufWriter::new(stdout.lock())).map_err(stdout_error);
+    };
+    let runtime = |e: std::io::Error| CliError::runtime(format!("{}: {e}", file.display()));
+    let f = std::fs::File::create(file).map_err(runtime)?;
+    write(&mut std::io::BufWriter::new(f)).map_err(runtime)?;
+    print(serde_json::json!({
+        "out": file.display().to_string(),
+        "points": rows.len(),
+        "gradient": gradient,
+    }))
 }
 
 fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
@@ -98,10 +166,10 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
         .out
         .as_ref()
         .ok_or_else(|| CliError::input("--slice needs --out FILE.svg"))?;
-    if !(4..=2000).contains(&a.resolution) {
+    let resolution = a.resolution.unwrap_or(DEFAULT_RESOLUTION);
+    if !(4..=2000).contains(&resolution) {
         return Err(CliError::input(format!(
-            "--resolution must be in 4..=2000, got {}",
-            a.resolution
+            "--resolution must be in 4..=2000, got {resolution}"
         )));
     }
     let quantity = match a.moment {
@@ -115,13 +183,13 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
         }
         None => MapQuantity::FluxDensity,
     };
-    if !(a.cutoff.is_finite() && a.cutoff > 0.0) {
+    let cutoff = a.cutoff.unwrap_or(DEFAULT_CUTOFF);
+    if !(cutoff.is_finite() && cutoff > 0.0) {
         return Err(CliError::input(format!(
-            "--cutoff must be > 0 [N], got {}",
-            a.cutoff
+            "--cutoff must be > 0 [N], got {cutoff}"
         )));
     }
-    let m = field_map(fs, slice, extent, a.resolution, quantity);
+    let m = field_map(fs, slice, extent, resolution, quantity);
     let names = ["x [m]", "y [m]", "z [m]"];
     let plane = ["x", "y", "z"][slice.0];
     let (title, label) = match quantity {
@@ -135,8 +203,8 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
         ),
     };
     let inside = m.inside.clone();
-    let (x0, dx) = (extent[0], (extent[1] - extent[0]) / a.resolution as f64);
-    let (y0, dy) = (extent[2], (extent[3] - extent[2]) / a.resolution as f64);
+    let (x0, dx) = (extent[0], (extent[1] - extent[0]) / resolution as f64);
+    let (y0, dy) = (extent[2], (extent[3] - extent[2]) / resolution as f64);
     let mut hm = Heatmap::new(
         title,
         (extent[0], extent[1]),
@@ -158,8 +226,8 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
     });
     let mut capture_area = None;
     if let MapQuantity::Force(_) = quantity {
-        hm = hm.contour(a.cutoff, format!("capture: F > {:e} N", a.cutoff));
-        let cells = m.values.iter().flatten().filter(|v| **v > a.cutoff).count();
+        hm = hm.contour(cutoff, format!("capture: F > {:e} N", cutoff));
+        let cells = m.values.iter().flatten().filter(|v| **v > cutoff).count();
         capture_area = Some(cells as f64 * dx * dy);
     }
     std::fs::write(out, hm.to_svg(720.0, 600.0))
@@ -175,7 +243,7 @@ fn map(fs: &FieldScene, a: &FieldArgs, slice: &str) -> Result<(), CliError> {
     print(serde_json::json!({
         "out": out.display().to_string(),
         "plane": format!("{plane}={}", slice.1),
-        "cells": a.resolution * a.resolution,
+        "cells": resolution * resolution,
         "quantity": label,
         "max": max,
         "capture_area_m2": capture_area,

@@ -149,10 +149,11 @@ enum Command {
     },
     /// Magnetic field of a scene's fibres: CSV at points, or a map in a plane.
     ///
-    /// `--points FILE.csv` (header `x,y,z` [m]) writes `x,y,z,bx,by,bz` [m, T] to stdout, plus
-    /// the nine `dbi_dj` [T/m] with `--gradient`. `--slice z=0 --extent X0,X1,Y0,Y1 --out
-    /// map.svg` draws |B|, or with `--moment` the attractive force on a particle with the
-    /// capture contour at `--cutoff`.
+    /// `--points FILE.csv` (header `x,y,z` [m]) writes `x,y,z,bx,by,bz` [m, T] to stdout (or
+    /// to `--out FILE.csv`), plus the nine `dbi_dj` [T/m] with `--gradient`. `--slice z=0
+    /// --extent X0,X1,Y0,Y1 --out map.svg` draws |B|, or with `--moment` the attractive force
+    /// on a particle with the capture contour at `--cutoff`. Options of the other mode are
+    /// refused (exit 2).
     Field {
         /// Scene file (TOML) with [[fibres]] and/or [external_field].
         scene: PathBuf,
@@ -168,18 +169,19 @@ enum Command {
         /// Map extent of the two in-plane axes: MIN1,MAX1,MIN2,MAX2 [m].
         #[arg(long, allow_hyphen_values = true)]
         extent: Option<String>,
-        /// Map output (SVG).
+        /// Map output (SVG); with --points, the CSV file (instead of stdout).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Cells per side of the map.
-        #[arg(long, default_value_t = 200)]
-        resolution: usize,
+        /// Cells per side of the map [default: 200].
+        #[arg(long)]
+        resolution: Option<usize>,
         /// Map the attractive force on a particle with this saturated moment [A m²].
         #[arg(long)]
         moment: Option<f64>,
-        /// Capture cut-off force [N] (thesis: 0.5e-15 N).
-        #[arg(long, default_value_t = 0.5e-15)]
-        cutoff: f64,
+        /// Capture cut-off force [N] of a force map (with --moment) [default: 0.5e-15 N, the
+        /// thesis's].
+        #[arg(long)]
+        cutoff: Option<f64>,
         /// Worker threads (default: all cores; at most 1024).
         #[arg(long)]
         threads: Option<usize>,

@@ -19,15 +19,37 @@ use crate::scene::Progress;
 pub const INTERVAL_ENV: &str = "MAGSEP_PROGRESS_INTERVAL";
 
 /// Interval of the plain progress lines: `MAGSEP_PROGRESS_INTERVAL` seconds when it is a
-/// positive number (at least 0.05 s), else 10 s.
+/// positive number (clamped to 0.05 s..1 day), else 10 s; any other value is warned about on
+/// stderr (once per process) and the default used.
 pub fn log_interval() -> Duration {
-    std::env::var(INTERVAL_ENV)
-        .ok()
-        .and_then(|s| s.trim().parse::<f64>().ok())
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .map_or(Duration::from_secs(10), |s| {
-            Duration::from_secs_f64(s.clamp(0.05, 86_400.0))
-        })
+    let value = std::env::var(INTERVAL_ENV).ok();
+    parse_interval(value.as_deref()).unwrap_or_else(|why| {
+        static WARNED: std::sync::Once = std::sync::Once::new();
+        WARNED.call_once(|| eprintln!("warning: {why}"));
+        DEFAULT_INTERVAL
+    })
+}
+
+/// The progress-line interval when `MAGSEP_PROGRESS_INTERVAL` is unset or not usable.
+pub const DEFAULT_INTERVAL: Duration = Duration::from_secs(10);
+
+/// The interval that a value of `MAGSEP_PROGRESS_INTERVAL` sets (`None`: unset, the default),
+/// or why the value is not usable.
+///
+/// # Errors
+/// A message naming the variable and its value, when it is not a positive number of seconds.
+pub fn parse_interval(value: Option<&str>) -> Result<Duration, String> {
+    let Some(value) = value else {
+        return Ok(DEFAULT_INTERVAL);
+    };
+    match value.trim().parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(Duration::from_secs_f64(s.clamp(0.05, 86_400.0))),
+        _ => Err(format!(
+            "{INTERVAL_ENV}={value:?} is not a positive number of seconds: progress lines \
+             every {} s",
+            DEFAULT_INTERVAL.as_secs()
+        )),
+    }
 }
 
 /// A progress display on stderr: a bar on a terminal, plain lines otherwise (see the module).
@@ -126,6 +148,23 @@ impl Progress for StderrProgress {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn interval_values() {
+        assert_eq!(parse_interval(None), Ok(DEFAULT_INTERVAL));
+        assert_eq!(
+            parse_interval(Some(" 2.5 ")),
+            Ok(Duration::from_millis(2500))
+        );
+        assert_eq!(parse_interval(Some("1e-9")), Ok(Duration::from_millis(50)));
+        for bad in ["abc", "", "0", "-1", "inf", "NaN"] {
+            let e = parse_interval(Some(bad)).unwrap_err();
+            assert!(
+                e.contains(INTERVAL_ENV) && e.contains(&format!("{bad:?}")),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn a_line_shows_counts_share_and_message() {

@@ -249,7 +249,8 @@ pub fn far_field_curve(
         .collect()
 }
 
-/// `magsep chart field --out DIR`: error against distance and against cost.
+/// `magsep chart field --out DIR [--quick]`: error against distance and against cost (quick:
+/// 3 distances and 50 samples instead of 9 and 400).
 ///
 /// # Errors
 /// [`BenchError::Runtime`] when the SVG cannot be written.

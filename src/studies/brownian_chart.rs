@@ -286,8 +286,9 @@ pub fn chart_brownian(out: &Path, quick: bool) -> Result<(), BenchError> {
                 "brownian_side": final_fraction(s, Some(1), "brownian_fraction").0,
             }));
         }
+        // the mean over the angles run (null, not 0, when none was)
         let mean = |v: &[(f64, (f64, f64, f64))]| {
-            v.iter().map(|x| x.1.0).sum::<f64>() / v.len().max(1) as f64
+            crate::studies::stats::mean(&v.iter().map(|x| x.1.0).collect::<Vec<_>>())
         };
         report[format!("angle_average_R{:.0}nm", r * 1e9)] = json!({
             "captured_volume_weighted": mean(&per_group[2]),

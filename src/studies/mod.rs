@@ -13,4 +13,5 @@ pub mod fluid_charts;
 pub mod liquid;
 pub mod packing_charts;
 pub mod sq_study;
+pub mod stats;
 pub mod sweep;

@@ -164,3 +164,45 @@ fn resume_of_an_ensemble_gives_the_whole_runs_summary_and_replay_says_it_has_one
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `replay` on the committed bad recordings (a brownian run): damage is reported under
+/// `damaged` (a CRC mismatch, bytes after the footer), a cut under `truncated` only, and the
+/// values that frames cannot give (the neighbour-list builds; the wall time of a file without
+/// run summary) are `null` and listed in `not_recomputed`.
+#[test]
+fn replay_names_damage_and_what_frames_cannot_give() {
+    let dir = std::path::Path::new("tests/data/bad_recordings");
+    let replay = |name: &str| magsep::replay::replay(&dir.join(name)).unwrap().0;
+    let listed = |s: &serde_json::Value, key: &str| {
+        (s["not_recomputed"].as_array()).is_some_and(|l| l.iter().any(|k| k == key))
+    };
+    let base = replay("base.mcap");
+    assert!(base.get("damaged").is_none() && base.get("truncated").is_none());
+    assert!(base["stepper"]["neighbour_list_builds"].is_null(), "{base}");
+    assert!(listed(&base, "stepper.neighbour_list_builds"), "{base}");
+    assert!(base["wall_time_s"].as_f64().is_some());
+    assert!(!listed(&base, "wall_time_s"));
+
+    let crc = replay("flip_chunk_data.mcap");
+    let d = crc["damaged"].as_str().unwrap_or_default();
+    assert!(d.contains("corrupt recording at byte 6265"), "{crc}");
+    assert!(crc.get("truncated").is_none(), "{crc}");
+
+    let trailing = replay("trailing_bytes.mcap");
+    let d = trailing["damaged"].as_str().unwrap_or_default();
+    assert!(
+        d.contains("100 trailing bytes after the footer"),
+        "{trailing}"
+    );
+    assert!(trailing.get("truncated").is_none(), "{trailing}");
+
+    let cut = replay("cut_mid_chunk.mcap");
+    assert!(
+        cut["truncated"].as_str().is_some() && cut.get("damaged").is_none(),
+        "{cut}"
+    );
+    assert!(
+        cut["wall_time_s"].is_null() && listed(&cut, "wall_time_s"),
+        "{cut}"
+    );
+}

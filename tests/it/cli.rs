@@ -256,3 +256,17 @@ fn progress_goes_to_a_log_as_plain_lines_and_quiet_silences_it() {
     assert!(o.status.success());
     assert!(!stderr(&o).contains(" steps"), "{}", stderr(&o));
 }
+
+#[test]
+fn an_unusable_progress_interval_is_warned_about_once() {
+    let scene = write("interval.toml", GOOD);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_magsep"))
+        .args(["run", scene.to_str().unwrap()])
+        .env(magsep::cli::progress::INTERVAL_ENV, "abc")
+        .output()
+        .expect("binary runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warned = err.matches("MAGSEP_PROGRESS_INTERVAL=\"abc\"").count();
+    assert_eq!(warned, 1, "{err}");
+}

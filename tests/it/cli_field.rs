@@ -162,3 +162,94 @@ fn field_bad_input_exits_2() {
         );
     }
 }
+
+/// `--out` in points mode writes the CSV file (the same bytes as stdout), never over an input;
+/// options of the other mode are refused with exit 2 instead of being ignored.
+#[test]
+fn field_points_out_writes_the_file_and_options_of_the_other_mode_are_refused() {
+    let scene = "scenes/fibres_three.toml";
+    let points = "scenes/points_example.csv";
+    let to_stdout = magsep(&["field", scene, "--points", points]);
+    assert_eq!(to_stdout.status.code(), Some(0));
+    let out = tmp("points_out.csv");
+    let _ = std::fs::remove_file(&out);
+    let o = magsep(&[
+        "field",
+        scene,
+        "--points",
+        points,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), to_stdout.stdout);
+    let said: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(said["points"], 5);
+    // an existing file needs --force; an input never
+    let again = magsep(&[
+        "field",
+        scene,
+        "--points",
+        points,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(again.status.code(), Some(2));
+    let over = magsep(&[
+        "field", scene, "--points", points, "--out", points, "--force",
+    ]);
+    assert_eq!(over.status.code(), Some(2));
+    for extra in [
+        &["--moment", "1e-15"][..],
+        &["--resolution", "50"],
+        &["--cutoff", "1e-15"],
+        &["--extent=-1,1,-1,1"],
+    ] {
+        let o = magsep(&[&["field", scene, "--points", points][..], extra].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(extra[0].split('=').next().unwrap()), "{err}");
+        assert!(o.stdout.is_empty(), "{extra:?}");
+    }
+    let map = tmp("refused_map.svg");
+    let slice = [
+        "field",
+        scene,
+        "--slice",
+        "z=0",
+        "--extent=-1e-3,1e-3,-1e-3,1e-3",
+    ];
+    for extra in [&["--cutoff", "1e-15"][..], &["--gradient"]] {
+        let args = [&slice[..], &["--out", map.to_str().unwrap()], extra].concat();
+        let o = magsep(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(extra[0]), "{err}");
+        assert!(!map.exists());
+    }
+}
+
+/// A points CSV saved by Excel starts with a UTF-8 byte-order mark: accepted.
+#[test]
+fn field_points_with_a_byte_order_mark_are_read() {
+    let csv = tmp("bom.csv");
+    std::fs::write(&csv, "\u{feff}x,y,z\r\n1e-3,0,0\r\n").unwrap();
+    let o = magsep(&[
+        "field",
+        "scenes/fibres_three.toml",
+        "--points",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(stdout(&o).lines().count(), 2);
+}

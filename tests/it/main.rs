@@ -12,6 +12,7 @@ mod brownian_replay;
 mod cli;
 mod cli_field;
 mod common;
+mod docs;
 mod field_reference;
 mod filter;
 mod fluid_charts;

@@ -442,6 +442,31 @@ fn bad_sweeps_fail_up_front_with_key_paths() {
     assert!(!e.contains("point 0 "), "{e}");
 }
 
+/// A typo in an axis path is the axis's error, reported once at `axes[k].path`, not repeated
+/// for every point.
+#[test]
+fn a_typo_in_an_axis_path_is_reported_once_at_the_axis() {
+    let dir = fresh("typo");
+    let sweep = write_sweep(
+        &dir,
+        &SWEEP.replace(
+            "path = \"brownian.duration\"",
+            "path = \"brownian.duraton\"",
+        ),
+    );
+    for args in [
+        vec!["sweep", &sweep, "--out", &out(&dir, "o"), "--quiet"],
+        vec!["validate", &sweep],
+    ] {
+        let o = magsep(&args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains("axes[1].path: `brownian.duraton`"), "{e}");
+        assert_eq!(e.matches("duraton").count(), 1, "{e}");
+        assert!(!e.contains("point 0"), "{e}");
+    }
+}
+
 #[test]
 fn zipped_axes_vary_together_and_ranges_are_typed() {
     let dir = fresh("zip");

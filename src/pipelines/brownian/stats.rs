@@ -35,7 +35,8 @@ pub struct Estimate {
 /// ```
 pub fn mean_interval(values: &[f64]) -> Estimate {
     let n = values.len();
-    let mean = values.iter().sum::<f64>() / n.max(1) as f64;
+    // the mean of no runs is undefined (NaN, JSON null), not 0
+    let mean = values.iter().sum::<f64>() / n as f64;
     if n < 2 {
         return Estimate {
             mean,
@@ -84,6 +85,15 @@ pub fn wilson(k: u64, n: u64) -> Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mean_of_no_runs_is_nan_not_zero() {
+        let e = mean_interval(&[]);
+        assert!(e.mean.is_nan() && e.lo.is_nan() && e.hi.is_nan());
+        let one = mean_interval(&[0.25]);
+        assert_eq!(one.mean, 0.25);
+        assert!(one.lo.is_nan() && one.hi.is_nan());
+    }
 
     #[test]
     fn interval_covers_the_mean_at_the_nominal_rate() {

@@ -127,10 +127,6 @@ impl Pipeline for PackingPipeline {
             detail: e.0,
         })?;
         app.observe_now();
-        let mut summary = packing_summary(&app.world, seed, recorded_wall_time(rec));
-        if let Some(t) = &rec.truncated {
-            summary["truncated"] = Value::String(t.clone());
-        }
-        Ok(summary)
+        Ok(packing_summary(&app.world, seed, recorded_wall_time(rec)))
     }
 }

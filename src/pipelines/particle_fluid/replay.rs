@@ -86,9 +86,6 @@ pub fn replay_particle_fluid(
         .map(|w| w[1].time - w[0].time)
         .fold(frames.first().map_or(0.0, |f| f.time), f64::max);
     summary["levitation_time_resolution_s"] = Value::from(resolution);
-    if let Some(t) = &rec.truncated {
-        summary["truncated"] = Value::String(t.clone());
-    }
     Ok(summary)
 }
 

@@ -111,6 +111,20 @@ fn delay(pair: Option<f64>, alone: Option<f64>) -> Option<f64> {
     Some(pair? / alone? - 1.0)
 }
 
+/// The JSON mean delays of history rule `rule` over the impact factors whose delay is defined
+/// (`sinking`, `rising`: (I, delay) points; `runs`: the impact factors run). Each mean is
+/// `null` when no delay is defined, never 0, and `pairs_used` says how many pairs it averages
+/// out of `pairs_run` (a pair whose particle never levitates has no delay).
+fn mean_delay(rule: &str, sinking: &[(f64, f64)], rising: &[(f64, f64)], runs: usize) -> Value {
+    let mean =
+        |v: &[(f64, f64)]| crate::studies::stats::mean(&v.iter().map(|p| p.1).collect::<Vec<_>>());
+    json!({
+        "history": rule, "sinking": mean(sinking), "rising": mean(rising),
+        "pairs_used": {"sinking": sinking.len(), "rising": rising.len()},
+        "pairs_run": runs,
+    })
+}
+
 /// Write the charts and print a JSON summary.
 ///
 /// # Errors
@@ -160,7 +174,6 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
             "collisions": p.summary["collisions"],
         }));
     }
-    let mean = |v: &[(f64, f64)]| v.iter().map(|p| p.1).sum::<f64>() / v.len().max(1) as f64;
     let mut delays = Chart::new("levitation delay of 1:2 spheroids against the impact factor")
         .x_label("I = lateral distance / d_major")
         .y_label("t_l(pair) / t_l(alone) - 1")
@@ -225,8 +238,29 @@ pub fn chart_flake_collisions(out: &Path, quick: bool) -> Result<(), BenchError>
         "quick": quick,
         "alone": {"sinking": t_sink, "rising": t_rise},
         "pairs": rows,
-        "mean_delay": rules.iter().zip(&curves).map(|(r, (a, b))| json!({
-            "history": r, "sinking": mean(a), "rising": mean(b)})).collect::<Vec<_>>(),
+        "mean_delay": rules.iter().zip(&curves)
+            .map(|(r, (a, b))| mean_delay(r, a, b, impacts.len()))
+            .collect::<Vec<_>>(),
         "thesis_mean_delay": {"sinking": THESIS_MEAN.0, "rising": THESIS_MEAN.1},
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mean_delay_of_no_pairs_is_null_and_counts_are_given() {
+        let none = mean_delay("reset", &[], &[], 2);
+        assert!(
+            none["sinking"].is_null() && none["rising"].is_null(),
+            "{none}"
+        );
+        assert_eq!(none["pairs_used"], json!({"sinking": 0, "rising": 0}));
+        assert_eq!(none["pairs_run"], json!(2));
+        let some = mean_delay("keep", &[(0.06, 0.1), (0.32, 0.3)], &[(0.06, -0.2)], 2);
+        assert!((some["sinking"].as_f64().unwrap() - 0.2).abs() < 1e-15);
+        assert_eq!(some["rising"], json!(-0.2));
+        assert_eq!(some["pairs_used"], json!({"sinking": 2, "rising": 1}));
+    }
 }

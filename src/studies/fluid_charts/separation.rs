@@ -96,12 +96,11 @@ fn mean_curve(runs: &[&(SeparationCurve, Value)]) -> SeparationCurve {
     mean
 }
 
-/// Mean and sample standard deviation (0 for one value).
-fn mean_sd(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let mean = x.iter().sum::<f64>() / n;
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    (mean, var.sqrt())
+/// The JSON fields of the seeds' times to e_m = 0.02 [s]: their mean and sample standard
+/// deviation (`null` for one seed: a spread of one value is undefined, not 0) and every seed's.
+fn time_fields(times: &[f64]) -> Value {
+    let (mean, sd) = crate::studies::stats::mean_sd(times);
+    json!({"time_to_0.02": mean, "time_to_0.02_sd": sd, "time_to_0.02_per_seed": times})
 }
 
 fn points(c: &SeparationCurve, values: &[f64]) -> Vec<(f64, f64)> {
@@ -220,17 +219,35 @@ pub fn chart_separation(out: &Path, quick: bool) -> Result<(), BenchError> {
         .zip(&results)
         .map(|((name, _, thesis), (curve, seeds))| {
             let times: Vec<f64> = seeds.iter().map(|r| r.0.time_to(0.02)).collect();
-            let (mean, sd) = mean_sd(&times);
-            json!({
+            let mut row = json!({
                 "case": name, "particles": seeds[0].1["particles"], "seeds": seeds.len(),
-                "time_to_0.02": mean, "time_to_0.02_sd": sd, "time_to_0.02_per_seed": times,
                 "thesis_time_to_0.02": thesis, "final_error": curve.total.last(),
                 "collisions": seeds.iter().map(|r| r.1["collisions"].clone()).collect::<Vec<_>>(),
                 "wall_time_s": seeds.iter().map(|r| r.1["wall_time_s"].clone()).collect::<Vec<_>>(),
-            })
+            });
+            if let (Some(row), Value::Object(t)) = (row.as_object_mut(), time_fields(&times)) {
+                row.extend(t);
+            }
+            row
         })
         .collect();
     crate::studies::bench::say(
         json!({"charts": [path.display().to_string(), path_g.display().to_string()], "quick": quick, "cases": cases}),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_seed_has_no_standard_deviation() {
+        let one = time_fields(&[1.25]);
+        assert_eq!(one["time_to_0.02"], json!(1.25));
+        assert!(one["time_to_0.02_sd"].is_null(), "{one}");
+        let two = time_fields(&[1.0, 3.0]);
+        assert!((two["time_to_0.02_sd"].as_f64().unwrap() - 2f64.sqrt()).abs() < 1e-15);
+        // a seed that never reached 0.02 (NaN) leaves the mean undefined: null
+        assert!(time_fields(&[1.0, f64::NAN])["time_to_0.02"].is_null());
+    }
 }

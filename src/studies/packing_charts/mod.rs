@@ -44,7 +44,7 @@ pub struct RunMeasures {
     pub cubatic: f64,
     /// Largest wall penetration / D after the run (<= tolerance).
     pub max_wall_penetration: f64,
-    /// Contact-solver fall-backs over evaluations.
+    /// Contact-solver fall-backs over evaluations (NaN when none was evaluated).
     pub fallback_rate: f64,
     /// Wall time \[s\].
     pub wall_time_s: f64,
@@ -87,7 +87,8 @@ pub fn measure(
         aligned,
         cubatic,
         max_wall_penetration: penetration,
-        fallback_rate: r.contact_fallbacks as f64 / (r.contact_evaluations.max(1) as f64),
+        // a rate over no evaluations is undefined: NaN (JSON null), not 0
+        fallback_rate: r.contact_fallbacks as f64 / r.contact_evaluations as f64,
         wall_time_s: r.wall_time_s,
     })
 }

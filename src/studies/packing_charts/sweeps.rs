@@ -152,7 +152,7 @@ pub fn chart_cylinder(out: &Path, quick: bool) -> Result<(), BenchError> {
         .line(Line::new("0.75", vec![(0.75, 0.0), (0.75, 1.0)]).dashed(true));
     let fig = Figure::new(
         format!(
-            "Spherocylinders in a hard cylinder, N = {n} or more (final length >= 3 particle lengths), {runs} runs per point (95 % intervals)"
+            "Spherocylinders in a hard cylinder, N = {n} or more (final length >= 3 particle lengths), {}", crate::studies::stats::runs_per_point(runs, true)
         ),
         2,
     )
@@ -289,7 +289,7 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
         .line(Line::new("thesis: 0.5 (aspect <= 2)", vec![(1.0, 0.5), (2.0, 0.5)]).dashed(true))
         .line(Line::new("thesis: > 0.8 (aspect >= 3)", vec![(3.0, 0.8), (5.0, 0.8)]).dashed(true));
     let fig = Figure::new(
-        format!("Spherocylinders in a hard wedge, N = {n} or more (final width >= 3 particle lengths), {runs} runs per point"),
+        format!("Spherocylinders in a hard wedge, N = {n} or more (final width >= 3 particle lengths), {}", crate::studies::stats::runs_per_point(runs, false)),
         3,
     )
     .panel(phi_star)
@@ -412,7 +412,10 @@ pub fn chart_superballs(out: &Path, quick: bool) -> Result<(), BenchError> {
     // S_4 of isotropic orientations is biased upwards by about 1/sqrt(N): the floor of this N
     let floor = magsep_systems::analysis::cubatic::isotropic_floor(n, 16, 7);
     let fig = Figure::new(
-        format!("Superballs, N = {n}, periodic, {runs} runs per point"),
+        format!(
+            "Superballs, N = {n}, periodic, {}",
+            crate::studies::stats::runs_per_point(runs, false)
+        ),
         3,
     )
     .panel(

@@ -75,13 +75,14 @@ pub fn chart(sweep: &Sweep, rows: &[Row], c: usize, a: usize) -> Option<Chart> {
         return None;
     }
     let (c_name, _) = &sweep.collect[c];
-    let mut chart = Chart::new(format!(
-        "{c_name} against {} (mean, 95 % CI over {} replicates)",
-        axis.name, sweep.replicates
-    ))
-    .x_label(label(&axis.name, axis.unit.as_deref()))
-    .y_label(c_name.clone())
-    .x_log(axis.log);
+    let over = match sweep.replicates {
+        1 => "one replicate, no CI".to_string(),
+        n => format!("mean, 95 % CI over {n} replicates"),
+    };
+    let mut chart = Chart::new(format!("{c_name} against {} ({over})", axis.name))
+        .x_label(label(&axis.name, axis.unit.as_deref()))
+        .y_label(c_name.clone())
+        .x_log(axis.log);
     for (key, by_x) in series {
         let name = if others.is_empty() {
             c_name.clone()

@@ -79,10 +79,13 @@ pub fn load_checked(
     let sweep = load(path)?;
     let all: Vec<usize> = (0..sweep.len()).collect();
     let memory = check_points(&sweep, registry, &all).map_err(|e| {
-        SweepError::Input(format!(
-            "{} is invalid: a point's scene does not validate:\n{e}",
-            path.display()
-        ))
+        // an axis's own fault (a path naming no key) is the sweep file's, not a point's
+        let what = if e.starts_with("axes[") {
+            ""
+        } else {
+            " a point's scene does not validate:"
+        };
+        SweepError::Input(format!("{} is invalid:{what}\n{e}", path.display()))
     })?;
     Ok((sweep, memory))
 }

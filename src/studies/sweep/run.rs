@@ -14,7 +14,7 @@ use serde_json::{Value, json};
 use toml_edit::DocumentMut;
 
 use super::file::{Point, Sweep, value_cell};
-use crate::scene::overrides::{apply_to_document, parse_document};
+use crate::scene::overrides::{Override, apply_to_document, parse_document};
 use crate::scene::{NoProgress, Registry, RunOptions, Scene, SceneErrors, parse_scene};
 use crate::sim::{SimError, Simulation, StopFlag, run_scene};
 
@@ -87,6 +87,10 @@ pub fn check_points(
     indices: &[usize],
 ) -> Result<Vec<PointMemory>, String> {
     let base = base_document(sweep).map_err(|e| format!("scene: {e}"))?;
+    let wrong_paths = axis_path_errors(sweep, &base, registry);
+    if !wrong_paths.is_empty() {
+        return Err(wrong_paths.join("\n"));
+    }
     let mut failing = Vec::new();
     let mut estimates = Vec::with_capacity(indices.len());
     let mut count = 0;
@@ -114,6 +118,49 @@ pub fn check_points(
         String::new()
     };
     Err(format!("{}{more}", failing.join("\n")))
+}
+
+/// The axes whose path names no key of the base scene (a typo), each reported once at
+/// `axes[k].path`: the axis's first value alone is set on the base scene, and an error of the
+/// override or an unknown key on the axis's path is the path's fault (every point would
+/// repeat it). Errors of the values are left to [`check_points`]'s points.
+fn axis_path_errors(sweep: &Sweep, base: &DocumentMut, registry: &Registry) -> Vec<String> {
+    let mut out = Vec::new();
+    for (k, axis) in sweep.axes.iter().enumerate() {
+        let Some(value) = axis.values.first() else {
+            continue;
+        };
+        let mut doc = base.clone();
+        let path = axis.path.to_string();
+        let ov = Override::new(axis.path.clone(), value.clone());
+        let errors = match apply_to_document(&mut doc, &ov) {
+            Err(e) => vec![e],
+            Ok(()) => match parse_scene(&doc.to_string(), registry) {
+                Err(SceneErrors(e)) => (e.into_iter())
+                    .filter(|e| e.message.starts_with("unknown key") && on_path(&path, &e.path))
+                    .collect(),
+                Ok(_) => Vec::new(),
+            },
+        };
+        out.extend(errors.iter().map(|e| {
+            let at = if e.path == path {
+                String::new()
+            } else {
+                format!(" (at {})", e.path)
+            };
+            format!(
+                "axes[{k}].path: `{path}` names no key of the scene{at}: {}",
+                e.message
+            )
+        }));
+    }
+    out
+}
+
+/// Whether key path `prefix` is `path` or one of its parents.
+fn on_path(path: &str, prefix: &str) -> bool {
+    path.strip_prefix(prefix)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
 }
 
 /// Spawn the scene of every point of `indices` and build its schedule with `plugins`,
