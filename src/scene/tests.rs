@@ -293,14 +293,7 @@ kind = "cube"
 
 #[test]
 fn fibres_are_spawned_as_entities_next_to_particles() {
-    let text = r#"
-[simulation]
-pipeline = "packing"
-[container]
-kind = "periodic_box"
-[[particles]]
-count = 4
-shape = { kind = "sphere", radius = 0.5 }
+    let fibres = r#"
 [external_field]
 flux_density = [0.0, 0.0, 1.0]
 [[fibres]]
@@ -310,7 +303,31 @@ half_length = 1.0
 axis = [0.0, 0.0, 2.0]
 magnetisation = [0.0, 0.0, 1e5]
 "#;
-    let scene = parse_scene(text, &Registry::default()).unwrap();
+    let text = format!(
+        r#"
+[simulation]
+pipeline = "brownian"
+[brownian]
+time_step = 1e-3
+duration = 1e-2
+mobility = "free_draining"
+contact = {{ kind = "none" }}
+dipole_cutoff = 0
+[[particles]]
+count = 2
+shape = {{ kind = "sphere", radius = 100e-9 }}
+placement = {{ kind = "box", min = [1.0, 1.0, 1.0], max = [1.001, 1.001, 1.001] }}
+{fibres}"#
+    );
+    // a pipeline that would ignore them refuses them at their keys
+    let packing = format!(
+        "[simulation]\npipeline = \"packing\"\n[container]\nkind = \"periodic_box\"\n\
+         [[particles]]\ncount = 4\nshape = {{ kind = \"sphere\", radius = 0.5 }}\n{fibres}"
+    );
+    let e = parse_scene(&packing, &Registry::default()).unwrap_err().0;
+    let paths: Vec<&str> = e.iter().map(|e| e.path.as_str()).collect();
+    assert_eq!(paths, ["fibres", "external_field"], "{e:?}");
+    let scene = parse_scene(&text, &Registry::default()).unwrap_or_else(|e| panic!("{e}"));
     let mut world = bevy_ecs::prelude::World::new();
     crate::scene::spawn_scene(&scene, &mut world, 1).unwrap();
     let mut q = world.query::<(
