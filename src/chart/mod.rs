@@ -408,12 +408,24 @@ impl Figure {
         let n = self.panels.len();
         let cols = self.columns.clamp(1, n.max(1));
         let rows = n.div_ceil(cols).max(1);
-        let title_h = if self.title.trim().is_empty() { 0 } else { 34 };
         let w = pw.saturating_mul(cols as u32);
+        let lines = self.title_lines(f64::from(w));
+        let title_h = match lines.len() {
+            0 => 0,
+            n => 34 + ((n - 1) as f64 * 1.25 * style::FS_FIGURE_TITLE) as u32,
+        };
         let h = title_h + ph.saturating_mul(rows as u32);
         render_svg(w, h, |root| {
             let _ = self.draw(root, title_h, (rows, cols));
         })
+    }
+
+    /// The figure title wrapped to `w` px (at most three lines; none when empty).
+    fn title_lines(&self, w: f64) -> Vec<String> {
+        if self.title.trim().is_empty() {
+            return Vec::new();
+        }
+        style::wrap(&self.title, w - 20.0, style::FS_FIGURE_TITLE, 3)
     }
 
     /// Draws the title into the top `title_h` px and the panels in a
@@ -427,13 +439,15 @@ impl Figure {
         let (title_area, panels) = root.split_vertically(title_h);
         if title_h > 0 {
             let w = f64::from(root.dim_in_pixel().0);
-            let text = style::fit(&self.title, w - 20.0, style::FS_FIGURE_TITLE);
             let anchor = Pos::new(HPos::Center, VPos::Center);
-            let font = style::bold(style::FS_FIGURE_TITLE)
-                .color(&style::INK)
-                .pos(anchor);
-            let at = ((w / 2.0) as i32, (title_h / 2) as i32);
-            title_area.draw(&plotters::element::Text::new(text, at, font))?;
+            for (k, line) in self.title_lines(w).into_iter().enumerate() {
+                let font = style::bold(style::FS_FIGURE_TITLE)
+                    .color(&style::INK)
+                    .pos(anchor);
+                let y = 17.0 + k as f64 * 1.25 * style::FS_FIGURE_TITLE;
+                let at = ((w / 2.0) as i32, y as i32);
+                title_area.draw(&plotters::element::Text::new(line, at, font))?;
+            }
         }
         for (panel, area) in self.panels.iter().zip(panels.split_evenly(grid)) {
             render::draw_chart(panel, &area)?;

@@ -9,7 +9,8 @@ use super::axis::{self, Axis, PlotAxis, Ticks, text_width};
 use super::data::{self, Trace};
 use super::legend::{self, Legend, Placement};
 use super::style::{
-    DASH, FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, MARKER_R, bold, clean, fit, font, marker_offsets,
+    DASH, FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, MARKER_R, bold, clean, font, marker_offsets,
+    wrap,
 };
 use super::{Chart, LegendPosition};
 
@@ -18,12 +19,18 @@ pub(crate) type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBacken
 
 /// Tick mark length, px.
 pub(crate) const TICK_LEN: i32 = 5;
+/// Most lines a panel title wraps to (the rest is shortened with an ellipsis).
+const TITLE_LINES: usize = 3;
+/// Distance between wrapped title lines, px.
+const TITLE_LINE_H: f64 = 1.25 * FS_TITLE;
 /// Space kept right of the plot frame (for the last x tick label), px.
 const RIGHT: f64 = 16.0;
 
 /// Panel geometry: title band, label areas and plot size, px.
 struct Layout {
     title_h: f64,
+    /// The title, wrapped to the panel's width (at most [`TITLE_LINES`] lines).
+    title_lines: Vec<String>,
     x_area: f64,
     y_area: f64,
     plot_w: f64,
@@ -36,10 +43,14 @@ struct Layout {
 /// legend placed (avoiding the data when automatic).
 fn layout(chart: &Chart, traces: &[Trace], xa: &Axis, ya: &Axis, w: f64, h: f64) -> Layout {
     let has = |s: &str| !s.trim().is_empty();
-    let title_h = if has(&chart.title) {
-        16.0 + FS_TITLE
+    let title_lines = if has(&chart.title) {
+        wrap(&chart.title, w - 16.0, FS_TITLE, TITLE_LINES)
     } else {
-        12.0
+        Vec::new()
+    };
+    let title_h = match title_lines.len() {
+        0 => 12.0,
+        n => 16.0 + FS_TITLE + (n - 1) as f64 * TITLE_LINE_H,
     };
     let x_area = f64::from(TICK_LEN)
         + 6.0
@@ -96,6 +107,7 @@ fn layout(chart: &Chart, traces: &[Trace], xa: &Axis, ya: &Axis, w: f64, h: f64)
     };
     let plot_w = width_for(reserve);
     Layout {
+        title_lines,
         title_h,
         x_area,
         y_area,
@@ -131,15 +143,14 @@ pub(crate) fn draw_chart<DB: DrawingBackend>(
     let lay = layout(chart, &traces, &xa, &ya, w, h);
 
     let (title_area, body) = area.split_vertically(lay.title_h as i32);
-    let title = chart.title.trim();
-    if !title.is_empty() {
-        let text = fit(title, w - 16.0, FS_TITLE);
+    for (k, line) in lay.title_lines.iter().enumerate() {
         let style = bold(FS_TITLE)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
+        let y = 10.0 + FS_TITLE / 2.0 + k as f64 * TITLE_LINE_H;
         title_area.draw(&Text::new(
-            text,
-            ((w / 2.0) as i32, (lay.title_h / 2.0 + 2.0) as i32),
+            line.as_str(),
+            ((w / 2.0) as i32, y as i32),
             style,
         ))?;
     }

@@ -96,6 +96,35 @@ pub(crate) fn fit(s: &str, max_px: f64, px: f64) -> String {
     out
 }
 
+/// `s` cleaned and broken at spaces into at most `max_lines` lines that each fit `max_px`
+/// at font size `px` (a word longer than a line is shortened); only the last line is
+/// shortened with an ellipsis when the text does not fit in `max_lines`. Titles carry the
+/// scene's reductions, which an ellipsis on one line would hide.
+pub(crate) fn wrap(s: &str, max_px: f64, px: f64, max_lines: usize) -> Vec<String> {
+    let s = clean(s);
+    let mut lines: Vec<String> = Vec::new();
+    let mut words = s.split(' ').filter(|w| !w.is_empty()).peekable();
+    while let Some(word) = words.next() {
+        if lines.len() + 1 == max_lines.max(1) {
+            // the last line takes the rest
+            let rest: Vec<&str> = std::iter::once(word).chain(words).collect();
+            lines.push(fit(&rest.join(" "), max_px, px));
+            break;
+        }
+        let mut line = word.to_string();
+        while let Some(next) = words.peek() {
+            let longer = format!("{line} {next}");
+            if text_width(&longer, px) > max_px {
+                break;
+            }
+            line = longer;
+            words.next();
+        }
+        lines.push(fit(&line, max_px, px));
+    }
+    lines
+}
+
 /// Outline of marker `shape` (cycling circle, square, triangle, diamond,
 /// inverted triangle) around pixel offset `(cx, cy)`.
 fn marker_outline(shape: usize, (cx, cy): (i32, i32)) -> Vec<(i32, i32)> {

@@ -338,3 +338,26 @@ fn write_creates_directories() {
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "<svg/>");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_long_title_wraps_onto_lines_instead_of_losing_its_end() {
+    let title = "Concentrated cloud (thesis 500 particles, 30 runs; here 10 runs); reduced: \
+                 adaptive steps (tol 0.01 R, max 1e-5 s), no hydrodynamic interactions";
+    let chart = Chart::new(title).series(Series::new("a", vec![(0.0, 1.0), (1.0, 2.0)]));
+    let t = texts(&chart.to_svg(480.0, 360.0));
+    // every word is there, over two or three lines, and nothing is cut
+    let words: Vec<&str> = title.split(' ').collect();
+    let lines = (t.iter())
+        .filter(|s| s.len() > 10 && title.contains(s.as_str()))
+        .count();
+    let joined = t.join(" ");
+    for w in &words {
+        assert!(joined.contains(w), "{w} missing from {t:?}");
+    }
+    assert!(!t.iter().any(|s| s.ends_with('…')), "{t:?}");
+    assert!(lines >= 2, "{t:?}");
+    // a title too long for three lines keeps an ellipsis on the last
+    let long = [title; 4].join(" ");
+    let t = texts(&Chart::new(&long).to_svg(480.0, 360.0));
+    assert!(t.iter().any(|s| s.ends_with('…')), "{t:?}");
+}

@@ -120,10 +120,6 @@ fn outputs_never_overwrite_inputs_even_with_force() {
     let o = magsep(&[
         "field",
         "scenes/fibres_three.toml",
-        "--slice",
-        "z=0",
-        "--extent",
-        "0,1e-3,0,1e-3",
         "--points",
         s(&points),
         "--out",
