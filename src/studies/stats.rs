@@ -2,26 +2,18 @@
 //! standard deviation of fewer than two are undefined: they are `None` (JSON `null`), never 0,
 //! so that a summary cannot report a statistic of nothing as a measured zero.
 
+use statrs::statistics::Statistics;
+
 /// The mean of `xs`, `None` when `xs` is empty.
 pub fn mean(xs: &[f64]) -> Option<f64> {
-    if xs.is_empty() {
-        return None;
-    }
-    Some(xs.iter().sum::<f64>() / xs.len() as f64)
+    (!xs.is_empty()).then(|| xs.mean())
 }
 
 /// The mean of `xs` (`None` when empty) and its sample standard deviation (n − 1 in the
-/// denominator; `None` for fewer than two values).
+/// denominator; `None` for fewer than two values). `statrs` computes both; it gives NaN
+/// where these give `None`.
 pub fn mean_sd(xs: &[f64]) -> (Option<f64>, Option<f64>) {
-    let m = mean(xs);
-    let sd = match m {
-        Some(m) if xs.len() >= 2 => {
-            let var = xs.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (xs.len() - 1) as f64;
-            Some(var.sqrt())
-        }
-        _ => None,
-    };
-    (m, sd)
+    (mean(xs), (xs.len() >= 2).then(|| xs.std_dev()))
 }
 
 /// "`n` runs per point" for a chart title, singular for one, with "(95 % intervals)" only when
