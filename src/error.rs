@@ -170,6 +170,10 @@ pub enum SpawnError {
     /// A pipeline or a plugin kind failed.
     #[error("{0}")]
     Other(String),
+    /// The run's stop flag was set while spawning (`magsep run` exits 130 or 143); the reason
+    /// given to the flag (e.g. `SIGINT`).
+    #[error("interrupted by {0} while spawning the scene (nothing ran)")]
+    Interrupted(String),
 }
 
 /// Errors while building or running a simulation.

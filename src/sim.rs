@@ -19,7 +19,7 @@ use serde_json::Value;
 
 pub use crate::error::SimError;
 use crate::names::short_name;
-pub use crate::scene::pipeline::StopFlag;
+pub use crate::scene::pipeline::{StopFlag, StopRequest};
 pub use crate::scene::{ExecutorChoice, RunOptions};
 use crate::scene::{NoProgress, Pipeline, Progress, RecordEvery, RunInfo, Scene, spawn_scene};
 
@@ -142,6 +142,10 @@ impl Simulation {
         };
         let seed = options.seed.unwrap_or(simulation.seed);
         let mut app = SimApp::new();
+        if let Some(stop) = &options.stop {
+            app.world
+                .insert_resource(crate::scene::pipeline::StopRequest(stop.clone()));
+        }
         spawn_scene(scene, &mut app.world, seed)?;
         let particles = app
             .world

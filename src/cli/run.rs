@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use crate::input::{named_inputs, read_scene_text};
 use crate::scene::memory::{self, MemoryEstimate};
 use crate::scene::overrides::{Override, apply_overrides};
-use crate::scene::{ExecutorChoice, RunOptions, Scene, parse_scene};
+use crate::scene::{ExecutorChoice, RunOptions, Scene, SpawnError, parse_scene};
 use crate::sim::{SimError, Simulation, StopFlag, run_scene};
 use indicatif::ProgressStyle;
 
@@ -240,6 +240,11 @@ pub fn run(ext: &Extensions, args: RunArgs) -> Result<(), CliError> {
         let _ = print(serde_json::to_string_pretty(partial).unwrap_or_default());
     }
     let summary = result.map_err(|e| match e.cause() {
+        // a signal during a long spawn (packing's random insertion): nothing ran
+        SimError::Spawn(SpawnError::Interrupted(_)) => CliError {
+            code: signals.exit_code().unwrap_or(130),
+            message: e.to_string(),
+        },
         // a scene that validates but cannot be spawned (a start region too small for its
         // particles, a start box inside a fibre) is bad input too
         // (and a schedule refused before the first step: e.g. a plugin's force the scene's

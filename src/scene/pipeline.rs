@@ -274,6 +274,12 @@ impl StopFlag {
     }
 }
 
+/// The run's [`StopFlag`] as a resource: in the world from before the pipeline spawns (when
+/// the run has a flag), so that a long spawn can end at a request too. The packing pipeline's
+/// random insertion polls it and then fails with [`SpawnError::Interrupted`].
+#[derive(Resource, Debug, Clone)]
+pub struct StopRequest(pub StopFlag);
+
 /// What a summary knows of the run beyond the world.
 #[derive(Debug, Clone, Copy)]
 pub struct RunInfo {

@@ -196,6 +196,32 @@ fn sigint_ends_a_packing_run_with_a_partial_summary_and_a_complete_recording() {
 }
 
 #[test]
+fn sigint_during_a_slow_random_insertion_ends_the_run() {
+    // the insertion polls the stop request every 1024 trials: the signal ends it at once
+    // instead of after its minutes of trials
+    let record = tmp("sigint_spawn.mcap");
+    let child = run_recorded("packing_slow_insertion.toml", &record);
+    // time for the handlers to be installed (the insertion itself runs for minutes)
+    std::thread::sleep(Duration::from_secs(2));
+    kill(&child, "INT");
+    let (out, took) = finish(child, Duration::from_secs(20));
+    assert_eq!(out.status.code(), Some(130), "stderr: {}", stderr(&out));
+    assert!(
+        stderr(&out).contains("interrupted by SIGINT while spawning the scene (nothing ran)"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    // the recording opens after spawning: there is none
+    assert!(!record.exists());
+    assert!(took < Duration::from_secs(5), "the stop took {took:?}");
+}
+
+#[test]
 fn sigterm_stops_every_replicate_of_a_brownian_ensemble() {
     let record = tmp("sigterm.mcap");
     let mut child = run_recorded("brownian_long.toml", &record);

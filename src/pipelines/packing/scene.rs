@@ -4,7 +4,7 @@
 use bevy_ecs::prelude::*;
 use magsep_components::packing::{OverlapRemovalScheme, PackingConfig, VolumeStepRule};
 use magsep_components::prelude::*;
-use magsep_systems::packing::insert::random_insertion;
+use magsep_systems::packing::insert::random_insertion_until;
 use magsep_systems::packing::state::Body;
 use magsep_systems::packing::systems::state_from_si;
 use magsep_systems::rng::particle_stream;
@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 
 use super::geometry::start_container;
 use crate::scene::checks::{check, finite_positive, in_range, within};
+use crate::scene::pipeline::StopRequest;
 use crate::scene::{ParseContext, Scene, SceneError, SpawnError};
+use crate::sim::StopFlag;
 
 /// The validated sections of a packing scene.
 #[derive(Debug, Clone, PartialEq)]
@@ -204,7 +206,12 @@ pub fn spawn_packing_particles(
         .map(|i| particle_stream(seed, i))
         .collect();
     let empty = state_from_si(&container, &[], &[], &[], d);
-    let state = random_insertion(&bodies, empty, &mut rngs)?;
+    let stop = world.get_resource::<StopRequest>().map(|s| s.0.clone());
+    let stopped = || stop.as_ref().is_some_and(StopFlag::is_stopped);
+    let Some(state) = random_insertion_until(&bodies, empty, &mut rngs, &stopped)? else {
+        let reason = stop.and_then(|s| s.reason()).unwrap_or_default();
+        return Err(SpawnError::Interrupted(reason));
+    };
     let species = scene.species_ids();
     for (i, rng) in rngs.into_iter().enumerate() {
         world.spawn(ParticleBundle {

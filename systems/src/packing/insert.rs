@@ -52,8 +52,40 @@ pub fn random_insertion(
     container: PackingState,
     rngs: &mut [Xoshiro256PlusPlus],
 ) -> Result<PackingState, InsertionError> {
-    let n = bodies.len();
     let mut state = container;
+    fill(bodies, &mut state, rngs, &|| false)?;
+    Ok(state)
+}
+
+/// Trials between two polls of the stop request in [`random_insertion_until`].
+pub const STOP_POLL_TRIALS: u64 = 1024;
+
+/// [`random_insertion`] that gives up, returning `Ok(None)`, once `stop()` says so (polled
+/// before each particle and every [`STOP_POLL_TRIALS`] trials): a slow insertion (a start
+/// packing fraction near the random sequential limit, costly superquadric contacts) then ends
+/// at a signal instead of running on for up to 10^6 trials per particle. Polling does not
+/// change the placements.
+///
+/// # Errors
+/// [`InsertionError`] when a particle finds no free place in 10^6 trials.
+pub fn random_insertion_until(
+    bodies: &[Body],
+    container: PackingState,
+    rngs: &mut [Xoshiro256PlusPlus],
+    stop: &dyn Fn() -> bool,
+) -> Result<Option<PackingState>, InsertionError> {
+    let mut state = container;
+    Ok(fill(bodies, &mut state, rngs, stop)?.then_some(state))
+}
+
+/// The insertion into `state`; `Ok(false)` when `stop()` ended it early.
+fn fill(
+    bodies: &[Body],
+    state: &mut PackingState,
+    rngs: &mut [Xoshiro256PlusPlus],
+    stop: &dyn Fn() -> bool,
+) -> Result<bool, InsertionError> {
+    let n = bodies.len();
     state.positions = Vec::with_capacity(n);
     state.orientations = Vec::with_capacity(n);
     state.bodies = Vec::with_capacity(n);
@@ -90,6 +122,9 @@ pub fn random_insertion(
         let rng = &mut rngs[i];
         let mut trials = 0;
         loop {
+            if trials % STOP_POLL_TRIALS == 0 && stop() {
+                return Ok(false);
+            }
             trials += 1;
             if trials > max_trials {
                 return Err(InsertionError {
@@ -148,5 +183,59 @@ pub fn random_insertion(
             }
         }
     }
-    Ok(state)
+    Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use magsep_components::shape::Shape;
+
+    use super::*;
+    use crate::rng::particle_stream;
+
+    /// `n` unit spheres and their streams for a periodic cube at packing fraction `phi`.
+    fn spheres(n: usize, phi: f64) -> (Vec<Body>, PackingState, Vec<Xoshiro256PlusPlus>) {
+        let shape = Shape::Sphere { radius: 0.5 };
+        let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
+        let v: f64 = bodies.iter().map(|b| b.volume).sum();
+        let rngs = (0..n as u64).map(|i| particle_stream(7, i)).collect();
+        (bodies, PackingState::periodic_cube((v / phi).cbrt()), rngs)
+    }
+
+    #[test]
+    fn an_unstopped_insertion_places_what_the_plain_one_places() {
+        let (bodies, empty, mut r1) = spheres(200, 0.2);
+        let mut r2 = r1.clone();
+        let plain = random_insertion(&bodies, empty.clone(), &mut r1).unwrap();
+        let polls = Cell::new(0u64);
+        let until = random_insertion_until(&bodies, empty, &mut r2, &|| {
+            polls.set(polls.get() + 1);
+            false
+        })
+        .unwrap();
+        assert_eq!(Some(plain), until);
+        // polled at least once per particle
+        assert!(polls.get() >= 200, "{} polls", polls.get());
+    }
+
+    #[test]
+    fn a_stop_ends_an_insertion_that_cannot_finish_within_a_few_polls() {
+        // at phi 0.6 random sequential insertion of spheres jams (near 0.38): some particle k
+        // would spend its 10^6 trials and fail. Each particle polls before its first trial, so
+        // the 301st poll falls among particle k's trials; the stop requested there ends it
+        let (bodies, empty, mut rngs) = spheres(300, 0.6);
+        let polls = Cell::new(0u64);
+        let out = random_insertion_until(&bodies, empty.clone(), &mut rngs, &|| {
+            polls.set(polls.get() + 1);
+            polls.get() > 300
+        });
+        assert_eq!(out, Ok(None));
+        assert_eq!(polls.get(), 301);
+        // without the stop the same insertion fails after its trials
+        let (bodies, empty, mut rngs) = spheres(300, 0.6);
+        let err = random_insertion(&bodies, empty, &mut rngs).unwrap_err();
+        assert!(err.trials > 1_000_000, "{err}");
+    }
 }
