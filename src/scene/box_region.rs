@@ -8,13 +8,15 @@
 //! convex polygon of up to six vertices). A(t) is exact: the disc ∩ polygon area is a sum
 //! over the polygon's edges of the signed area of disc ∩ triangle (disc centre, edge), each a
 //! triangle or circular sectors plus a triangle. The t integral is numerical: the range is
-//! split where the plane passes a box corner (where the polygon changes its vertices, A's
-//! kinks) and each piece is integrated by adaptive 5-point Gauss–Legendre (a piece is accepted
-//! when its two halves agree with it to 1e-13 of the cylinder's volume, depth at most 40).
-//! Between breakpoints A(t) is smooth but where the disc's rim touches a polygon edge or
-//! vertex (a (t - t0)^{3/2} term), which the bisection resolves; the result is within about
-//! 1e-12 of the cylinder's volume (relative), and exact to rounding when the axis is parallel
-//! to a box edge (A is then constant between breakpoints). Cylinders wholly inside or wholly
+//! split wherever A(t) is not smooth — where the plane passes a box corner (the polygon
+//! changes its vertices), where the disc's rim touches the line of a box face (a
+//! (t - t0)^{3/2} term) and where it passes a polygon vertex (closed-form roots of quadratics
+//! in t) — and each analytic piece is integrated by adaptive 5-point Gauss–Legendre (a piece
+//! is accepted when its two halves agree with it to 1e-13 of the cylinder's volume; depth at
+//! most 40 and 10^5 bisections per cylinder, a bound on the cost whatever the input). The
+//! result agrees with exact cases to 1e-13 and with a 20 000-piece composite rule to 1e-10
+//! (relative; tests), and is exact to rounding when the axis is parallel to a box edge (A is
+//! then constant between breakpoints). Cylinders wholly inside or wholly
 //! outside the box are decided from their bounding boxes first (2πR²L or 0, no quadrature).
 //!
 //! The fibres are taken not to overlap one another inside the box: their volumes inside it
@@ -140,6 +142,7 @@ pub(crate) fn cylinder_volume_in_box(c: &Cylinder, lo: DVec3, hi: DVec3) -> f64 
     if !(b > a) {
         return 0.0;
     }
+    ts.extend(rim_events(c, lo, hi));
     ts.retain(|&t| t > a && t < b);
     ts.push(a);
     ts.push(b);
@@ -147,21 +150,59 @@ pub(crate) fn cylinder_volume_in_box(c: &Cylinder, lo: DVec3, hi: DVec3) -> f64 
     let (u, v) = e.any_orthonormal_pair();
     let area = |t: f64| section_area(c.center + t * e, e, u, v, r, lo, hi);
     let tol = 1e-13 * full;
+    let mut budget = MAX_PIECES;
     ts.windows(2)
         .map(|w| {
             let whole = gauss5(&area, w[0], w[1]);
-            adaptive(
-                &area,
-                w[0],
-                w[1],
-                whole,
-                tol * (w[1] - w[0]) / (2.0 * h),
-                40,
-            )
+            let piece_tol = tol * (w[1] - w[0]) / (2.0 * h);
+            adaptive(&area, (w[0], w[1]), whole, piece_tol, 40, &mut budget)
         })
         .sum::<f64>()
         .clamp(0.0, full)
 }
+
+/// The sections t where the disc's rim touches a box face's line (tangent) or passes a
+/// polygon vertex (a box edge's crossing of the plane): where A(t) is not smooth (besides
+/// the corners' planes). Between all these A is analytic, so the quadrature's halving test
+/// is reliable there.
+fn rim_events(c: &Cylinder, lo: DVec3, hi: DVec3) -> Vec<f64> {
+    let (e, r) = (c.axis, c.radius);
+    let mut ts = Vec::new();
+    for k in 0..3 {
+        let (ek, ck) = (e[k], c.center[k]);
+        if ek == 0.0 {
+            continue;
+        }
+        // face x_k = d: its line in the section lies |d - p_k(t)| / sqrt(1 - e_k^2) from
+        // the disc centre p(t) = c + t e
+        let off = r * (1.0 - ek * ek).max(0.0).sqrt();
+        for d in [lo[k], hi[k]] {
+            ts.push((d - ck - off) / ek);
+            ts.push((d - ck + off) / ek);
+        }
+        // edges along axis k through the corners with x_k = lo_k: the crossing
+        // q(t) = P + s(t) x_k, (q - c).e = t, lies at q - p = a0 + t b from the centre
+        let unit = DVec3::AXES[k];
+        for corner in corners(lo, hi).iter().filter(|p| p[k] == lo[k]) {
+            let pc = *corner - c.center;
+            let a0 = pc - (pc.dot(e) / ek) * unit;
+            let b = unit / ek - e;
+            let (qa, qb, qc) = (b.dot(b), a0.dot(b), a0.dot(a0) - r * r);
+            let disc = qb * qb - qa * qc;
+            if qa > 0.0 && disc >= 0.0 {
+                let sq = disc.sqrt();
+                ts.push((-qb - sq) / qa);
+                ts.push((-qb + sq) / qa);
+            }
+        }
+    }
+    ts.retain(|t| t.is_finite());
+    ts
+}
+
+/// Most bisections of one cylinder's integral: a bound on its cost whatever the input
+/// (smooth pieces need a few dozen; the tolerance is met long before).
+const MAX_PIECES: u32 = 100_000;
 
 /// 5-point Gauss–Legendre estimate of ∫_a^b f.
 fn gauss5(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
@@ -179,14 +220,24 @@ fn gauss5(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     sum * s
 }
 
-/// ∫_a^b f by bisection until the halves agree with `whole` (its estimate) within `tol`.
-fn adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
+/// ∫_a^b f by bisection until the halves agree with `whole` (its estimate) within `tol`, at
+/// most `depth` levels deep and `budget` bisections in all (then the halves are taken).
+fn adaptive(
+    f: &impl Fn(f64) -> f64,
+    (a, b): (f64, f64),
+    whole: f64,
+    tol: f64,
+    depth: u32,
+    budget: &mut u32,
+) -> f64 {
     let m = 0.5 * (a + b);
     let (left, right) = (gauss5(f, a, m), gauss5(f, m, b));
-    if depth == 0 || (left + right - whole).abs() <= tol.max(f64::MIN_POSITIVE) {
+    if depth == 0 || *budget == 0 || (left + right - whole).abs() <= tol.max(f64::MIN_POSITIVE) {
         return left + right;
     }
-    adaptive(f, a, m, left, 0.5 * tol, depth - 1) + adaptive(f, m, b, right, 0.5 * tol, depth - 1)
+    *budget -= 1;
+    adaptive(f, (a, m), left, 0.5 * tol, depth - 1, budget)
+        + adaptive(f, (m, b), right, 0.5 * tol, depth - 1, budget)
 }
 
 /// Area \[m²\] of the disc of radius `r` about `p0` in the plane through `p0` with normal `e`
@@ -302,7 +353,9 @@ mod tests {
         let f = fibre(c.to_array(), e.to_array(), r, 20e-3);
         let v = box_volume_outside_fibres(LO, HI, &[f]);
         let exact = whole - PI * r * r * 3e-3 / e.x;
-        assert!(rel(v, exact) < 1e-11, "{v} against {exact}");
+        // relative to the fibre's part in the box (the box is 1e3 times larger)
+        let err = (v - exact).abs() / (PI * r * r * 3e-3 / e.x);
+        assert!(err < 1e-11, "{v} against {exact}");
     }
 
     #[test]
@@ -355,8 +408,66 @@ mod tests {
             }
         }
         let reference = count as f64 * size.element_product();
+        eprintln!(
+            "oblique cut: {v:e} m^3, grid {reference:e} m^3, {:e}",
+            rel(v, reference)
+        );
         // the grid's error: its cells along the surface, ~ area * cell / volume ~ 1e-3 here
         assert!(rel(v, reference) < 3e-3, "{v} against {reference}");
         assert!(v > 0.0 && v < PI * c.radius.powi(2) * 2.0 * c.half_length);
+        // the adaptive rule against the simple one: 5-point Gauss-Legendre on 20 000 equal
+        // pieces of the whole length, no breakpoints (it converges to 1e-11 here from 2 000
+        // pieces on)
+        let (u, w) = c.axis.any_orthonormal_pair();
+        let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);
+        let n = 20_000;
+        let h = 2.0 * c.half_length / n as f64;
+        let simple: f64 = (0..n)
+            .map(|k| {
+                let a = -c.half_length + k as f64 * h;
+                gauss5(&area, a, a + h)
+            })
+            .sum();
+        assert!(rel(v, simple) < 1e-10, "{v} against {simple}");
+    }
+
+    /// Adaptive against the simple composite rule for fibres of several directions and
+    /// places cutting the box's faces, edges and corners.
+    #[test]
+    fn the_adaptive_rule_agrees_with_the_simple_one_in_every_direction() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..12 {
+            let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+            let corner = if case % 2 == 0 { HI } else { LO };
+            let c = Cylinder {
+                center: corner + 1e-3 * DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5),
+                axis,
+                radius: 2e-4 + 8e-4 * next(),
+                half_length: 4e-4 + 2e-3 * next(),
+            };
+            let v = cylinder_volume_in_box(&c, LO, HI);
+            let (u, w) = c.axis.any_orthonormal_pair();
+            let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);
+            let n = 20_000;
+            let h = 2.0 * c.half_length / n as f64;
+            let simple: f64 = (0..n)
+                .map(|k| {
+                    let a = -c.half_length + k as f64 * h;
+                    gauss5(&area, a, a + h)
+                })
+                .sum();
+            let full = PI * c.radius.powi(2) * 2.0 * c.half_length;
+            assert!(
+                (v - simple).abs() < 1e-10 * full,
+                "case {case}: {v} against {simple}"
+            );
+            assert!(v > 0.0 && v < full, "case {case}: {v}");
+        }
     }
 }
