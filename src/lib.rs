@@ -23,6 +23,7 @@ pub mod pipelines;
 pub mod replay;
 pub mod scene;
 pub mod sim;
+pub mod stats;
 pub mod studies;
 
 pub use pipelines::{brownian, packing, particle_fluid};

@@ -11,6 +11,7 @@ use crate::chart::axis::{self, Axis, PlotAxis, Ticks, text_width};
 use crate::chart::render::{Drawn, TICK_LEN};
 use crate::chart::style::{
     FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, bold, clean, fit, font, sample_dashed, sample_solid,
+    wrap,
 };
 
 /// Colour bar width and its distance from the plot, px.
@@ -28,6 +29,10 @@ const DASHES: [Option<(u32, u32)>; 4] = [None, Some((7, 4)), Some((2, 4)), Some(
 const MAX_ASPECT: f64 = 20.0;
 /// Colour steps of the colour bar.
 const BAR_STEPS: usize = 64;
+/// Most lines the title wraps to (the rest is shortened with an ellipsis), as a chart's.
+const TITLE_LINES: usize = 3;
+/// Distance between wrapped title lines, px.
+const TITLE_LINE_H: f64 = 1.25 * FS_TITLE;
 
 /// Plot rectangle (px), label area sizes and ticks of the plot and bar.
 struct Layout {
@@ -44,14 +49,23 @@ struct Layout {
 }
 
 impl Heatmap {
+    /// The title wrapped to a `w` px document (at most [`TITLE_LINES`] lines; none when
+    /// the title is blank).
+    fn title_lines(&self, w: f64) -> Vec<String> {
+        let title = self.title.trim();
+        if title.is_empty() {
+            return Vec::new();
+        }
+        wrap(title, w - 16.0, FS_TITLE, TITLE_LINES)
+    }
+
     /// Plot rectangle (centred, keeping the data aspect ratio), colour bar
     /// and ticks for a `w` x `h` px document.
     fn layout(&self, g: &Grid, ca: &Axis, w: f64, h: f64) -> Layout {
         let has = |s: &str| !s.trim().is_empty();
-        let top = if has(&self.title) {
-            24.0 + FS_TITLE
-        } else {
-            14.0
+        let top = match self.title_lines(w).len() {
+            0 => 14.0,
+            n => 24.0 + FS_TITLE + (n - 1) as f64 * TITLE_LINE_H,
         };
         let x_area = f64::from(TICK_LEN)
             + 6.0
@@ -119,21 +133,19 @@ pub(super) fn draw<DB: DrawingBackend>(hm: &Heatmap, root: &DrawingArea<DB, Shif
     let ca = hm.colour_axis(&g);
     let lay = hm.layout(&g, &ca, f64::from(w), f64::from(h));
     let px = |v: f64| v.round() as i32;
-    let title = hm.title.trim();
-    if !title.is_empty() {
-        let text = fit(title, f64::from(w) - 16.0, FS_TITLE);
+    // the title's lines above the plot, the last where a one-line title sits
+    let lines = hm.title_lines(f64::from(w));
+    let n = lines.len();
+    for (k, text) in lines.into_iter().enumerate() {
         let half = text_width(&text, FS_TITLE) / 2.0;
         let cx = (lay.x0 + lay.pw / 2.0)
             .min(f64::from(w) - 8.0 - half)
             .max(8.0 + half);
+        let cy = lay.y0 - 10.0 - FS_TITLE / 2.0 - (n - 1 - k) as f64 * TITLE_LINE_H;
         let style = bold(FS_TITLE)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
-        root.draw(&Text::new(
-            text,
-            (px(cx), px(lay.y0 - 10.0 - FS_TITLE / 2.0)),
-            style,
-        ))?;
+        root.draw(&Text::new(text, (px(cx), px(cy)), style))?;
     }
     let main = root.clone().shrink(
         (px(lay.x0 - lay.y_area), px(lay.y0)),

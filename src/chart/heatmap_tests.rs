@@ -409,3 +409,35 @@ fn row_zero_is_at_the_bottom() {
             .all(|(a, b)| (a.1 - 0.42).abs() < 1e-12 && (b.1 - 0.42).abs() < 1e-12)
     );
 }
+
+#[test]
+fn a_long_heatmap_title_wraps_onto_lines_instead_of_losing_its_end() {
+    let title = "Capture probability around one fibre (thesis fig. 6.9, 30 runs; here 10 runs); \
+                 reduced: adaptive steps (tol 0.01 R), no hydrodynamic interactions";
+    let svg = Heatmap {
+        title: title.into(),
+        ..radial()
+    }
+    .to_svg(480.0, 400.0);
+    let t = texts(&svg);
+    let joined = t.join(" ");
+    for w in title.split(' ') {
+        assert!(joined.contains(w), "{w} missing from {t:?}");
+    }
+    assert!(!t.iter().any(|s| s.ends_with('…')), "{t:?}");
+    let lines = t
+        .iter()
+        .filter(|s| s.len() > 10 && title.contains(s.as_str()))
+        .count();
+    assert!(lines >= 2, "{t:?}");
+    // a title too long for three lines keeps an ellipsis on the last
+    let long = [title; 4].join(" ");
+    let t = texts(
+        &Heatmap {
+            title: long,
+            ..radial()
+        }
+        .to_svg(480.0, 400.0),
+    );
+    assert!(t.iter().any(|s| s.ends_with('…')), "{t:?}");
+}

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 use super::axis::{Axis, text_width};
 use super::data::{self, Trace};
 use super::render::Drawn;
-use super::style::{DASH, FS_TICK, INK, fit, font, sample_dashed, sample_marker, sample_solid};
+use super::style::{DASH, FS_TICK, INK, font, sample_dashed, sample_marker, sample_solid, wrap};
 
 /// Inner margin of the legend box, px.
 const MARGIN: f64 = 6.0;
@@ -19,6 +19,9 @@ pub(super) const SAMPLE_AREA: f64 = SAMPLE + 2.0 * MARGIN;
 const ROW: f64 = FS_TICK * 1.6;
 /// Distance plotters keeps between an inside legend and the frame, px.
 const INSET: f64 = 5.0;
+/// Most lines an entry wraps to (the rest is shortened with an ellipsis): entries that
+/// differ only at their end (two settings of one method) must not read alike.
+const ENTRY_LINES: usize = 3;
 
 /// Where the legend goes.
 #[derive(Clone)]
@@ -29,8 +32,8 @@ pub(super) enum Placement {
     Outside,
 }
 
-/// Legend rows (trace index and shortened name; `None` for the "+N more"
-/// row) and box size, px.
+/// Legend rows (trace index and the first line of its name; `None` for a wrapped name's
+/// further lines and the "+N more" row) and box size, px.
 pub(super) struct Legend {
     rows: Vec<(Option<usize>, String)>,
     pub w: f64,
@@ -39,8 +42,9 @@ pub(super) struct Legend {
 
 impl Legend {
     /// Entries for every named trace, or `None` if there are none. Names are
-    /// shortened to `max_text` px; rows beyond what fits in `plot_h` px are
-    /// summarised as "+N more".
+    /// wrapped at spaces to lines of `max_text` px (at most [`ENTRY_LINES`] per
+    /// entry, the sample on the first); entries beyond the rows that fit in
+    /// `plot_h` px are summarised as "+N more".
     pub fn new(traces: &[Trace], plot_h: f64, max_text: f64) -> Option<Legend> {
         let named: Vec<usize> = (0..traces.len())
             .filter(|&i| !traces[i].name.trim().is_empty())
@@ -49,17 +53,32 @@ impl Legend {
             return None;
         }
         let max_rows = (((plot_h - 2.0 * INSET - 2.0 * MARGIN) / ROW).floor() as usize).max(2);
-        let keep = if named.len() > max_rows {
-            max_rows - 1
-        } else {
-            named.len()
-        };
-        let mut rows: Vec<(Option<usize>, String)> = named[..keep]
+        let lines: Vec<Vec<String>> = named
             .iter()
-            .map(|&i| (Some(i), fit(&traces[i].name, max_text, FS_TICK)))
+            .map(|&i| wrap(&traces[i].name, max_text, FS_TICK, ENTRY_LINES))
             .collect();
-        if keep < named.len() {
-            rows.push((None, format!("+{} more", named.len() - keep)));
+        let all = lines.iter().map(Vec::len).sum::<usize>() <= max_rows;
+        // without room for all, one row is kept for "+N more"
+        let budget = if all { max_rows } else { max_rows - 1 };
+        let mut rows: Vec<(Option<usize>, String)> = Vec::new();
+        let mut kept = 0;
+        for (&i, entry) in named.iter().zip(&lines) {
+            let room = budget - rows.len();
+            let entry = if entry.len() <= room {
+                entry.clone()
+            } else if kept == 0 && room > 0 {
+                // the first entry is shown, in the rows there are
+                wrap(&traces[i].name, max_text, FS_TICK, room)
+            } else {
+                break;
+            };
+            for (k, line) in entry.into_iter().enumerate() {
+                rows.push(((k == 0).then_some(i), line));
+            }
+            kept += 1;
+        }
+        if kept < named.len() {
+            rows.push((None, format!("+{} more", named.len() - kept)));
         }
         let text_w = rows
             .iter()

@@ -278,7 +278,7 @@ fn legend_positions() {
         let svg = base.clone().legend(pos).to_svg(640.0, 420.0);
         assert!(texts(&svg).iter().any(|s| s == "ref"), "{pos:?}");
     }
-    // Many long entries: shortened and summarised, still XML.
+    // Many long entries: wrapped (not cut) and summarised, still XML.
     let mut busy = Chart::new("busy");
     for i in 0..40 {
         busy = busy.series(Series::new(
@@ -288,7 +288,8 @@ fn legend_positions() {
     }
     let t = texts(&busy.to_svg(500.0, 300.0));
     assert!(t.iter().any(|s| s.ends_with(" more")), "{t:?}");
-    assert!(t.iter().any(|s| s.ends_with('…')));
+    assert!(!t.iter().any(|s| s.ends_with('…')), "{t:?}");
+    assert!(t.iter().any(|s| s == "series number 0 with a"), "{t:?}");
 }
 
 #[test]
@@ -360,4 +361,39 @@ fn a_long_title_wraps_onto_lines_instead_of_losing_its_end() {
     let long = [title; 4].join(" ");
     let t = texts(&Chart::new(&long).to_svg(480.0, 360.0));
     assert!(t.iter().any(|s| s.ends_with('…')), "{t:?}");
+}
+
+#[test]
+fn long_legend_entries_wrap_so_that_entries_differing_at_their_end_stay_apart() {
+    let a = "spectral Ewald mobility, tolerance 1e-6, 64 grid points per side, 1 thread";
+    let b = "spectral Ewald mobility, tolerance 1e-6, 64 grid points per side, 2 threads";
+    let chart = Chart::new("cost")
+        .series(Series::new(a, vec![(0.0, 1.0), (1.0, 2.0)]))
+        .series(Series::new(b, vec![(0.0, 1.5), (1.0, 2.5)]));
+    for w in [480.0, 640.0] {
+        let t = texts(&chart.to_svg(w, 360.0));
+        assert!(!t.iter().any(|s| s.ends_with('…')), "{t:?}");
+        // both entries in full, over lines of their own: their ends differ
+        let joined = t.join(" ");
+        assert!(joined.contains("per side, 1 thread spectral"), "{t:?}");
+        assert!(joined.ends_with("per side, 2 threads"), "{t:?}");
+        for word in b.split(' ') {
+            assert!(joined.contains(word), "{word} missing from {t:?}");
+        }
+        let spectral = t.iter().filter(|s| s.starts_with("spectral Ewald")).count();
+        assert_eq!(spectral, 2, "{t:?}");
+    }
+    // more entries than rows: the rest summarised, never cut mid-entry
+    let mut many = Chart::new("many");
+    for k in 0..12 {
+        many = many.series(Series::new(
+            format!("{a} {k}"),
+            vec![(0.0, k as f64), (1.0, k as f64)],
+        ));
+    }
+    let t = texts(&many.to_svg(480.0, 240.0));
+    assert!(
+        t.iter().any(|s| s.starts_with('+') && s.ends_with("more")),
+        "{t:?}"
+    );
 }

@@ -66,14 +66,17 @@ fn fibre_dims(fibres: &[FibreSpec], k: usize) -> Option<(f64, f64)> {
 }
 
 impl PlacementSpec {
-    /// Volume of the start region \[m³\] (the weight of a group in volume-weighted averages;
-    /// `None` for explicit points).
+    /// Volume of the start region \[m³\] the particles can occupy (the weight of a group in
+    /// volume-weighted averages; `None` for explicit points): a box's volume less the parts
+    /// of the fibres inside it (`scene::box_region` gives the method and its accuracy).
     pub fn volume(&self, fibres: &[FibreSpec]) -> Option<f64> {
         use std::f64::consts::PI;
         match self {
-            Self::Box { min, max } => {
-                Some((DVec3::from_array(*max) - DVec3::from_array(*min)).element_product())
-            }
+            Self::Box { min, max } => Some(super::box_region::box_volume_outside_fibres(
+                DVec3::from_array(*min),
+                DVec3::from_array(*max),
+                fibres,
+            )),
             Self::FibreTop { fibre, height, .. } => {
                 fibre_dims(fibres, *fibre).map(|(r, _)| PI * r * r * height)
             }

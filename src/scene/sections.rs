@@ -209,7 +209,8 @@ pub struct ParticleGroup {
     /// Initial velocity [m/s] (particle_fluid). Default zero.
     #[serde(default)]
     pub velocity: Option<[f64; 3]>,
-    /// Initial orientation of non-spherical particles (particle_fluid). Default broadside.
+    /// Initial orientation of spheroids (particle_fluid; refused on a sphere, which it would
+    /// not affect). Default broadside.
     #[serde(default)]
     pub orientation: Option<OrientationSpec>,
     /// Volume fraction Φ of the container instead of `count`: count = floor(Φ V / V_p)

@@ -330,3 +330,65 @@ max_compression_steps = 400
     assert!(summary["max_overlap"].as_f64().unwrap() <= 1e-4 * 0.6 * (1.0 + 1e-9));
     assert_eq!(summary["contact_fallbacks"].as_u64(), Some(0));
 }
+
+/// A `spheroid` in a packing scene is the ellipsoid (a, a, c) (a superquadric with exponents
+/// 2): given by any of its forms it packs exactly as that ellipsoid does (same summary, same
+/// recorded final positions and orientations), against walls of a box and a cylinder.
+#[test]
+fn a_spheroid_packs_exactly_as_the_ellipsoid_of_its_semi_axes() {
+    // d_major = 1 m and w = 0.5: a = 0.5 m, c = 0.25 m (an oblate spheroid, a lentil)
+    let spheroid = r#"{ kind = "spheroid", major_diameter = 1.0, aspect_ratio = 0.5 }"#;
+    let radii = r#"{ kind = "spheroid", equatorial_radius = 0.5, polar_radius = 0.25 }"#;
+    let ellipsoid = r#"{ kind = "ellipsoid", semi_axes = [0.5, 0.5, 0.25] }"#;
+    let prolate = r#"{ kind = "spheroid", equatorial_radius = 0.3, polar_radius = 0.6 }"#;
+    let prolate_e = r#"{ kind = "ellipsoid", semi_axes = [0.3, 0.3, 0.6] }"#;
+    let extra = "max_compression_steps = 6";
+    let cases = [
+        ("box", "kind = \"closed_box\"", spheroid, ellipsoid),
+        ("radii", "kind = \"closed_box\"", radii, ellipsoid),
+        (
+            "cylinder",
+            "kind = \"cylinder\"\nradius = 2.0",
+            spheroid,
+            ellipsoid,
+        ),
+        ("prolate", "kind = \"closed_box\"", prolate, prolate_e),
+    ];
+    for (tag, container, a, b) in cases {
+        let run = |shape: &str, which: &str| {
+            run_recorded(
+                &scene(container, shape, 16, extra),
+                &format!("spheroid-{tag}-{which}"),
+            )
+        };
+        let (worst_a, mut sum_a, path_a) = run(a, "spheroid");
+        let (worst_b, mut sum_b, path_b) = run(b, "ellipsoid");
+        for s in [&mut sum_a, &mut sum_b] {
+            s.as_object_mut().unwrap().remove("wall_time_s");
+        }
+        assert_eq!(sum_a, sum_b, "{tag}");
+        assert!(sum_a["compression_steps"].as_u64().unwrap() >= 1, "{tag}");
+        assert_eq!(worst_a.to_bits(), worst_b.to_bits(), "{tag}");
+        let (ra, rb) = (
+            read_recording(&path_a).unwrap(),
+            read_recording(&path_b).unwrap(),
+        );
+        let (fa, fb) = (ra.frames.last().unwrap(), rb.frames.last().unwrap());
+        assert_eq!(fa.positions, fb.positions, "{tag}");
+        assert_eq!(fa.orientations, fb.orientations, "{tag}");
+        assert_eq!(fa.box_edges, fb.box_edges, "{tag}");
+    }
+    // a periodic box (its frames record no container): the same summary
+    let summary = |shape: &str| {
+        let s = parse_scene(
+            &scene("kind = \"periodic_box\"", shape, 16, extra),
+            &Default::default(),
+        )
+        .unwrap();
+        let mut sim = Simulation::from_scene(&s, RunOptions::default()).unwrap();
+        let mut out = sim.run(|_| {}).unwrap();
+        out.as_object_mut().unwrap().remove("wall_time_s");
+        out
+    };
+    assert_eq!(summary(spheroid), summary(ellipsoid));
+}

@@ -105,6 +105,20 @@ pub fn spawn_brownian(
                 )));
             }
             let Some(p) = found else {
+                if let PlacementSpec::Box { min, max } = placement
+                    && let Some(j) = crate::scene::box_region::box_inside_fibre(
+                        DVec3::from_array(*min),
+                        DVec3::from_array(*max),
+                        &scene.fibres,
+                        a,
+                    )
+                {
+                    return Err(SpawnError::Other(format!(
+                        "particles[{g}].placement: the start box lies inside fibre {j} (every \
+                         point of it inside the fibre or closer to its surface than the \
+                         particle radius {a:e} m): no particle can start there"
+                    )));
+                }
                 return Err(SpawnError::Other(format!(
                     "particles[{g}]: no overlap-free place for particle {k} after {MAX_ATTEMPTS} \
                      attempts (start region too small for count = {})",

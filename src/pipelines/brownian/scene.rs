@@ -355,6 +355,23 @@ pub fn validate_group(
                     format!("{q}.max"),
                     format!("must exceed min on every axis, got min {min:?}, max {max:?}"),
                 ));
+            } else if let Some(fibres) = fibres
+                && let Some(k) = crate::scene::box_region::box_inside_fibre(
+                    glam::DVec3::from_array(*min),
+                    glam::DVec3::from_array(*max),
+                    fibres,
+                    radius,
+                )
+            {
+                errors.push(SceneError::new(
+                    q.clone(),
+                    format!(
+                        "the start box lies inside fibre {k} (every point of it inside the fibre \
+                         or closer to its surface than the particle radius {} m): no particle \
+                         can start there",
+                        num(radius)
+                    ),
+                ));
             }
         }
         PlacementSpec::FibreTop { fibre, gap, height } => {

@@ -161,3 +161,33 @@ fn step_control_keys_default_one_by_one() {
         ["brownian.step_control.max_depth"]
     );
 }
+
+#[test]
+fn a_box_region_volume_leaves_out_the_fibre_inside_it() {
+    // the fibre (axis z, R = 300 um, half length 6 mm) crosses the 2 x 2 x 4 mm box
+    let text = GOOD.replace(
+        "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
+        "placement = { kind = \"box\", min = [-1e-3, -1e-3, -2e-3], max = [1e-3, 1e-3, 2e-3] }",
+    );
+    let s = parse_scene(&text, &Default::default()).unwrap();
+    let v = s.particles[0]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
+    let pi = std::f64::consts::PI;
+    let exact = 2e-3 * 2e-3 * 4e-3 - pi * 300e-6f64.powi(2) * 4e-3;
+    assert!((v - exact).abs() < 1e-13 * exact, "{v} against {exact}");
+    // a box inside the fibre is refused at its placement, naming the fibre
+    let inside = GOOD.replace(
+        "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
+        "placement = { kind = \"box\", min = [-1e-4, -1e-4, 0.0], max = [1e-4, 1e-4, 1e-3] }",
+    );
+    let e = errors(&inside);
+    let hit = e
+        .iter()
+        .find(|e| e.path == "particles[0].placement")
+        .expect("an error at the placement");
+    assert!(hit.message.contains("inside fibre 0"), "{}", hit.message);
+}

@@ -25,7 +25,8 @@ pub struct Estimate {
 }
 
 /// Mean of per-run values with a Student-t interval (runs are independent replicates; the
-/// particles within one run are not, as dipoles and hydrodynamics couple them).
+/// particles within one run are not, as dipoles and hydrodynamics couple them), by the shared
+/// [`crate::stats::mean_ci95`].
 ///
 /// ```
 /// use magsep::brownian::stats::mean_interval;
@@ -34,22 +35,18 @@ pub struct Estimate {
 /// assert!((e.hi - e.mean - 4.302_652_729_749_46 * 0.1 / 3f64.sqrt()).abs() < 1e-9);
 /// ```
 pub fn mean_interval(values: &[f64]) -> Estimate {
-    let n = values.len();
-    // the mean of no runs is undefined (NaN, JSON null), not 0
-    let mean = values.iter().sum::<f64>() / n as f64;
-    if n < 2 {
-        return Estimate {
+    // the mean of no runs is undefined (NaN, JSON null), not 0; one run has no interval
+    match crate::stats::mean_ci95(values) {
+        (mean, Some(half)) => Estimate {
+            mean,
+            lo: mean - half,
+            hi: mean + half,
+        },
+        (mean, None) => Estimate {
             mean,
             lo: f64::NAN,
             hi: f64::NAN,
-        };
-    }
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-    let half = t_quantile_95(n - 1) * (var / n as f64).sqrt();
-    Estimate {
-        mean,
-        lo: mean - half,
-        hi: mean + half,
+        },
     }
 }
 

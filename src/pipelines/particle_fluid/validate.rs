@@ -304,19 +304,17 @@ fn validate_group(
         return;
     }
     if let Some(o) = g.orientation {
-        let ok = match o {
-            OrientationSpec::Axis(v) => {
-                v.iter().all(|c| c.is_finite() && c.abs() <= 1e6)
-                    && v.iter().map(|c| c * c).sum::<f64>() > 1e-24
-            }
-            OrientationSpec::Tilt(deg) => deg.is_finite() && deg.abs() <= 180.0,
-            _ => true,
-        };
-        check(errors, ok, &format!("{p}.orientation"), || {
-            "must be \"broadside\", \"edge_on\", \"random\", { axis = [x, y, z] } (non-zero, \
-             finite) or { tilt = degrees } in [-180, 180]"
-                .into()
-        });
+        // a sphere looks and moves the same in every orientation: its start orientation has
+        // no effect on the run, so a given one is a mistake (a spheroid meant, or a stray key)
+        if matches!(g.shape.shape(), Shape::Sphere { .. }) {
+            errors.push(SceneError::new(
+                format!("{p}.orientation"),
+                "a sphere has no orientation to set (it only sets a spheroid's symmetry \
+                 axis): remove it, or give a spheroid shape",
+            ));
+        } else {
+            check_orientation(o, &p, errors);
+        }
     }
     match (g.density, &g.density_ratios) {
         (Some(rho), None) => {
@@ -459,4 +457,21 @@ fn validate_group(
             "the particle_fluid pipeline places particles by box, points or injection",
         )),
     }
+}
+
+/// A spheroid's `orientation` is a non-zero finite axis or a tilt in [-180, 180] degrees.
+fn check_orientation(o: OrientationSpec, p: &str, errors: &mut Vec<SceneError>) {
+    let ok = match o {
+        OrientationSpec::Axis(v) => {
+            v.iter().all(|c| c.is_finite() && c.abs() <= 1e6)
+                && v.iter().map(|c| c * c).sum::<f64>() > 1e-24
+        }
+        OrientationSpec::Tilt(deg) => deg.is_finite() && deg.abs() <= 180.0,
+        _ => true,
+    };
+    check(errors, ok, &format!("{p}.orientation"), || {
+        "must be \"broadside\", \"edge_on\", \"random\", { axis = [x, y, z] } (non-zero, \
+         finite) or { tilt = degrees } in [-180, 180]"
+            .into()
+    });
 }

@@ -5,25 +5,15 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use statrs::distribution::{ContinuousCDF, StudentsT};
-
 use super::file::{Sweep, value_cell, value_number};
 use super::table::Row;
 use crate::chart::{Chart, Series, write_svg};
 
 /// Mean and half-width of the 95 % confidence interval of `ys` (t quantile with n - 1
-/// degrees of freedom; 0 for a single value).
+/// degrees of freedom; 0 for a single value): [`crate::stats::mean_ci95`].
 pub fn mean_ci95(ys: &[f64]) -> (f64, f64) {
-    let n = ys.len() as f64;
-    let mean = ys.iter().sum::<f64>() / n;
-    if ys.len() < 2 {
-        return (mean, 0.0);
-    }
-    let var = ys.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    let t = StudentsT::new(0.0, 1.0, n - 1.0)
-        .map(|d| d.inverse_cdf(0.975))
-        .unwrap_or(f64::NAN);
-    (mean, t * (var / n).sqrt())
+    let (mean, half) = crate::stats::mean_ci95(ys);
+    (mean, half.unwrap_or(0.0))
 }
 
 /// A file-name-safe form of `s`.
