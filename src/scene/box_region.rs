@@ -414,17 +414,23 @@ mod tests {
         // the adaptive rule against the simple one: 5-point Gauss-Legendre on 20 000 equal
         // pieces of the whole length, no breakpoints (it converges to 1e-11 here from 2 000
         // pieces on)
+        let simple = composite(&c);
+        assert!(rel(v, simple) < 1e-10, "{v} against {simple}");
+    }
+
+    /// The part of `c` inside the box `LO`..`HI` by the simple rule: 5-point Gauss-Legendre on
+    /// 20 000 equal pieces of the whole length, no breakpoints.
+    fn composite(c: &Cylinder) -> f64 {
         let (u, w) = c.axis.any_orthonormal_pair();
         let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);
         let n = 20_000;
         let h = 2.0 * c.half_length / n as f64;
-        let simple: f64 = (0..n)
+        (0..n)
             .map(|k| {
                 let a = -c.half_length + k as f64 * h;
                 gauss5(&area, a, a + h)
             })
-            .sum();
-        assert!(rel(v, simple) < 1e-10, "{v} against {simple}");
+            .sum()
     }
 
     /// Adaptive against the simple composite rule for fibres of several directions and
@@ -448,16 +454,7 @@ mod tests {
                 half_length: 4e-4 + 2e-3 * next(),
             };
             let v = cylinder_volume_in_box(&c, LO, HI);
-            let (u, w) = c.axis.any_orthonormal_pair();
-            let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);
-            let n = 20_000;
-            let h = 2.0 * c.half_length / n as f64;
-            let simple: f64 = (0..n)
-                .map(|k| {
-                    let a = -c.half_length + k as f64 * h;
-                    gauss5(&area, a, a + h)
-                })
-                .sum();
+            let simple = composite(&c);
             let full = PI * c.radius.powi(2) * 2.0 * c.half_length;
             assert!(
                 (v - simple).abs() < 1e-10 * full,
