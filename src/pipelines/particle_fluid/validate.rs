@@ -103,8 +103,10 @@ pub fn validate(
         "particle_fluid.duration",
         || {
             format!(
-                "must give 1 to 1e9 steps of time_step, got {}",
-                num(s.duration)
+                "must give 1 to 1e9 steps of time_step ({} s), got {} s ({} steps)",
+                num(s.time_step),
+                num(s.duration),
+                num(steps)
             )
         },
     );
@@ -113,7 +115,7 @@ pub fn validate(
             errors,
             g.is_finite() && (0.0..=1000.0).contains(&g),
             "particle_fluid.gravity",
-            || format!("must be in [0, 1000] m/s², got {g}"),
+            || format!("must be in [0, 1000] m/s², got {}", num(g)),
         );
     }
     if let Some(t) = s.levitation_tolerance {
@@ -130,7 +132,13 @@ pub fn validate(
             errors,
             window.is_finite() && window >= s.time_step && window / s.time_step <= 1.6e7,
             "particle_fluid.history.window",
-            || format!("must be >= time_step and at most 1.6e7 steps [s], got {window}"),
+            || {
+                format!(
+                    "must be >= time_step ({} s) and at most 1.6e7 steps, got {} s",
+                    num(s.time_step),
+                    num(window)
+                )
+            },
         );
     }
     let (lo, hi) = DENSITY_RANGE;
