@@ -42,7 +42,7 @@ use magsep_components::brownian::{
 use serde::{Deserialize, Serialize};
 
 use super::flow::{BrownianFlow, validate_flow};
-use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, num, within};
+use crate::scene::checks::{LENGTH_RANGE, VISCOSITY_RANGE, num, num4, within};
 use crate::scene::{FibreSpec, PlacementSpec, SceneError};
 
 /// Temperatures accepted \[K\] (a temperature near 0 switches the noise off, for
@@ -282,16 +282,23 @@ pub fn validate_group(
     // a moment above MAX_MAGNETISATION times the particle's volume is not a material's
     let volume = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
     let largest = MAX_MAGNETISATION * volume;
+    // without a valid radius (reported at the shape) there is no upper bound to state
+    let radius_ok = radius.is_finite() && radius > 0.0;
     let moment_in_range = |errors: &mut Vec<SceneError>, key: &str, m: f64| {
-        if !(m.is_finite() && m > 0.0 && m <= largest) {
-            errors.push(SceneError::new(
-                format!("{p}.moment.{key}"),
+        if !(m.is_finite() && m > 0.0 && (!radius_ok || m <= largest)) {
+            let bound = if radius_ok {
                 format!(
-                    "must be in (0, {}] [A m²] (a sphere of radius {} m magnetised at {} A/m), got {m}",
-                    num(largest),
+                    "in (0, {}] [A m²] (a sphere of radius {} m magnetised at {} A/m)",
+                    num4(largest),
                     num(radius),
                     num(MAX_MAGNETISATION)
-                ),
+                )
+            } else {
+                "positive and finite [A m²] (its upper bound follows from the radius)".into()
+            };
+            errors.push(SceneError::new(
+                format!("{p}.moment.{key}"),
+                format!("must be {bound}, got {}", num(m)),
             ));
         }
     };
