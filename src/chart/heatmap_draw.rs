@@ -10,8 +10,8 @@ use super::{Grid, Heatmap, chains, colour_t, march, viridis};
 use crate::chart::axis::{self, Axis, PlotAxis, Ticks, text_width};
 use crate::chart::render::{Drawn, TICK_LEN};
 use crate::chart::style::{
-    FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, bold, clean, fit, font, sample_dashed, sample_solid,
-    wrap,
+    FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, TITLE_LINE_H, bold, clean, fit, font, sample_dashed,
+    sample_solid, title_lines,
 };
 
 /// Colour bar width and its distance from the plot, px.
@@ -29,10 +29,6 @@ const DASHES: [Option<(u32, u32)>; 4] = [None, Some((7, 4)), Some((2, 4)), Some(
 const MAX_ASPECT: f64 = 20.0;
 /// Colour steps of the colour bar.
 const BAR_STEPS: usize = 64;
-/// Most lines the title wraps to (the rest is shortened with an ellipsis), as a chart's.
-const TITLE_LINES: usize = 3;
-/// Distance between wrapped title lines, px.
-const TITLE_LINE_H: f64 = 1.25 * FS_TITLE;
 
 /// Plot rectangle (px), label area sizes and ticks of the plot and bar.
 struct Layout {
@@ -49,14 +45,9 @@ struct Layout {
 }
 
 impl Heatmap {
-    /// The title wrapped to a `w` px document (at most [`TITLE_LINES`] lines; none when
-    /// the title is blank).
+    /// The title wrapped to a `w` px document (see [`title_lines`]).
     fn title_lines(&self, w: f64) -> Vec<String> {
-        let title = self.title.trim();
-        if title.is_empty() {
-            return Vec::new();
-        }
-        wrap(title, w - 16.0, FS_TITLE, TITLE_LINES)
+        title_lines(&self.title, w - 16.0)
     }
 
     /// Plot rectangle (centred, keeping the data aspect ratio), colour bar

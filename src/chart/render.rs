@@ -9,8 +9,8 @@ use super::axis::{self, Axis, PlotAxis, Ticks, text_width};
 use super::data::{self, Trace};
 use super::legend::{self, Legend, Placement};
 use super::style::{
-    DASH, FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, MARKER_R, bold, clean, font, marker_offsets,
-    wrap,
+    DASH, FRAME, FS_LABEL, FS_TICK, FS_TITLE, INK, MARKER_R, TITLE_LINE_H, bold, clean, font,
+    marker_offsets, title_lines,
 };
 use super::{Chart, LegendPosition};
 
@@ -19,10 +19,6 @@ pub(crate) type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBacken
 
 /// Tick mark length, px.
 pub(crate) const TICK_LEN: i32 = 5;
-/// Most lines a panel title wraps to (the rest is shortened with an ellipsis).
-const TITLE_LINES: usize = 3;
-/// Distance between wrapped title lines, px.
-const TITLE_LINE_H: f64 = 1.25 * FS_TITLE;
 /// Space kept right of the plot frame (for the last x tick label), px.
 const RIGHT: f64 = 16.0;
 
@@ -43,11 +39,7 @@ struct Layout {
 /// legend placed (avoiding the data when automatic).
 fn layout(chart: &Chart, traces: &[Trace], xa: &Axis, ya: &Axis, w: f64, h: f64) -> Layout {
     let has = |s: &str| !s.trim().is_empty();
-    let title_lines = if has(&chart.title) {
-        wrap(&chart.title, w - 16.0, FS_TITLE, TITLE_LINES)
-    } else {
-        Vec::new()
-    };
+    let title_lines = title_lines(&chart.title, w - 16.0);
     let title_h = match title_lines.len() {
         0 => 12.0,
         n => 16.0 + FS_TITLE + (n - 1) as f64 * TITLE_LINE_H,

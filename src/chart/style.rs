@@ -96,6 +96,21 @@ pub(crate) fn fit(s: &str, max_px: f64, px: f64) -> String {
     out
 }
 
+/// Most lines a panel's or a heatmap's title wraps to (the rest is shortened with an
+/// ellipsis).
+pub(crate) const TITLE_LINES: usize = 3;
+/// Distance between wrapped title lines, px.
+pub(crate) const TITLE_LINE_H: f64 = 1.25 * FS_TITLE;
+
+/// A panel's or a heatmap's `title` wrapped to `max_px` ([`wrap`] at [`FS_TITLE`], at most
+/// [`TITLE_LINES`] lines; none when the title is blank).
+pub(crate) fn title_lines(title: &str, max_px: f64) -> Vec<String> {
+    if title.trim().is_empty() {
+        return Vec::new();
+    }
+    wrap(title, max_px, FS_TITLE, TITLE_LINES)
+}
+
 /// `s` cleaned and broken at spaces into at most `max_lines` lines that each fit `max_px`
 /// at font size `px` (a word longer than a line is shortened); only the last line is
 /// shortened with an ellipsis when the text does not fit in `max_lines`. Titles carry the
