@@ -96,6 +96,15 @@ pub(crate) fn box_inside_fibre(
         .position(|f| Cylinder::of(f).is_some_and(|c| cs.iter().all(|&p| c.distance(p) <= margin)))
 }
 
+/// The message for a start box that [`box_inside_fibre`] found inside fibre `k` (particle
+/// radius `radius` \[m\]).
+pub(crate) fn inside_fibre_message(k: usize, radius: &str) -> String {
+    format!(
+        "the start box lies inside fibre {k} (every point of it inside the fibre or closer to \
+         its surface than the particle radius {radius} m): no particle can start there"
+    )
+}
+
 /// Volume \[m³\] of the box `lo`..`hi` \[m\] outside the fibres (0 when less than 1e-12 of
 /// the box is left; see the module header for the method, its accuracy and the non-overlap
 /// assumption).

@@ -114,9 +114,8 @@ pub fn spawn_brownian(
                     )
                 {
                     return Err(SpawnError::Other(format!(
-                        "particles[{g}].placement: the start box lies inside fibre {j} (every \
-                         point of it inside the fibre or closer to its surface than the \
-                         particle radius {a:e} m): no particle can start there"
+                        "particles[{g}].placement: {}",
+                        crate::scene::box_region::inside_fibre_message(j, &format!("{a:e}"))
                     )));
                 }
                 return Err(SpawnError::Other(format!(

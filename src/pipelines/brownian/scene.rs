@@ -372,12 +372,7 @@ pub fn validate_group(
             {
                 errors.push(SceneError::new(
                     q.clone(),
-                    format!(
-                        "the start box lies inside fibre {k} (every point of it inside the fibre \
-                         or closer to its surface than the particle radius {} m): no particle \
-                         can start there",
-                        num(radius)
-                    ),
+                    crate::scene::box_region::inside_fibre_message(k, &num(radius)),
                 ));
             }
         }
