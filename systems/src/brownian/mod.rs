@@ -3,6 +3,7 @@
 //! * [`hydro`]: mobilities (free draining, Rotne-Prager-Yamakawa) and Brownian displacements
 //!   (dense Cholesky, TEA-HI, Krylov/Lanczos square root).
 
+pub mod balance;
 pub mod cells;
 pub mod contact;
 pub mod dynamics;

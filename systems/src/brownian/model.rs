@@ -83,6 +83,8 @@ pub struct PairLists {
     pub capture_gaps: Vec<Option<super::contact::GapBound>>,
     /// The per-pair buffer of the dipole sum, kept across evaluations.
     pub pair_scratch: super::verlet::PairScratch,
+    /// The learnt shifts of the parts' bounds ([`super::balance`]).
+    pub balance: super::balance::PartBalance,
 }
 
 impl PairLists {

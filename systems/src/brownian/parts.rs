@@ -16,6 +16,7 @@
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -42,12 +43,24 @@ pub fn part_count(n: usize) -> usize {
 /// `parts + 1` bounds splitting `0..n` into contiguous parts of about equal cost, where
 /// `prefix(i)` is the (nondecreasing) cost of the particles `0..i`.
 pub fn balanced_bounds(n: usize, parts: usize, prefix: impl Fn(usize) -> u64) -> Vec<usize> {
+    shifted_bounds(n, parts, &[], prefix)
+}
+
+/// [`balanced_bounds`] with the cost target of inner bound `p` (1-based) moved by
+/// `shifts[p - 1]` times the total cost (see [`super::balance`]; missing shifts are zero).
+pub fn shifted_bounds(
+    n: usize,
+    parts: usize,
+    shifts: &[f64],
+    prefix: impl Fn(usize) -> u64,
+) -> Vec<usize> {
     let parts = parts.max(1);
     let total = prefix(n) as u128;
     let mut bounds = Vec::with_capacity(parts + 1);
     bounds.push(0);
     for p in 1..parts {
-        let target = total * p as u128 / parts as u128;
+        let share = p as f64 / parts as f64 + shifts.get(p - 1).copied().unwrap_or(0.0);
+        let target = (total as f64 * share.clamp(0.0, 1.0)) as u128;
         // the first i whose prefix reaches the target
         let (mut lo, mut hi) = (*bounds.last().unwrap_or(&0), n);
         while lo < hi {
@@ -67,11 +80,18 @@ pub fn balanced_bounds(n: usize, parts: usize, prefix: impl Fn(usize) -> u64) ->
 /// The parts of `n` particles for the pair lists `lists` ([`part_count`] of them): about
 /// equal dipole pairs owned (the pair pass, weighted twice), list entries (the gathers) and
 /// particles (the update). Every phase of a step asks for these same bounds.
+/// The bounds are moved from the cost model's by the shifts the lists' [`PartBalance`](super::balance::PartBalance) learnt
+/// from the pair pass's part times ([`super::balance`]).
 pub fn part_bounds(lists: &PairLists, n: usize) -> Vec<usize> {
+    let parts = part_count(n);
+    let shifts = lists.balance.shifts(parts, n);
+    shifted_bounds(n, parts, &shifts, |i| part_cost_before(lists, i))
+}
+
+/// The cost model of [`part_bounds`] of the particles `0..i`.
+fn part_cost_before(lists: &PairLists, i: usize) -> u64 {
     let (d, c) = (&lists.dipole, &lists.contact);
-    balanced_bounds(n, part_count(n), |i| {
-        2 * d.owned_before(i) + d.entries_before(i) + c.entries_before(i) + PARTICLE_COST * i as u64
-    })
+    2 * d.owned_before(i) + d.entries_before(i) + c.entries_before(i) + PARTICLE_COST * i as u64
 }
 
 /// The displacement tests of the dipole and contact lists ([`super::verlet::VerletList::within_skin`])
@@ -168,7 +188,10 @@ pub fn pair_forces_in_parts(
         .zip(split_at_bounds(contact, &bounds))
         .collect();
     let range = model.contact_range(view);
+    // each part's time and thread, for the balance of the bounds
+    let clocks: Vec<Mutex<(f64, usize)>> = (0..items.len()).map(|_| Mutex::new((0.0, 0))).collect();
     run_parts(items, |p, ((own, d), c)| {
+        let started = Instant::now();
         let (a, b) = (bounds[p], bounds[p + 1]);
         let base = slot_bounds[p];
         if let Some(cut) = cut {
@@ -216,9 +239,24 @@ pub fn pair_forces_in_parts(
             };
             c[i - a] = model.contact_force_on(x, view, lists, range, i);
         }
+        if let Some(Ok(mut clock)) = clocks.get(p).map(Mutex::lock) {
+            let thread = rayon::current_thread_index().unwrap_or(usize::MAX);
+            *clock = (started.elapsed().as_secs_f64(), thread);
+        }
     });
     if cut.is_some() {
         lists.pair_scratch.put(pf);
+    }
+    if bounds.len() > 2 {
+        let (time, thread): (Vec<f64>, Vec<usize>) = clocks
+            .into_iter()
+            .map(|c| c.into_inner().unwrap_or((0.0, usize::MAX)))
+            .unzip();
+        let cost: Vec<u64> = bounds
+            .windows(2)
+            .map(|w| part_cost_before(lists, w[1]) - part_cost_before(lists, w[0]))
+            .collect();
+        lists.balance.observe(n, &cost, &time, &thread);
     }
 }
 
