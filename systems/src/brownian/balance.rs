@@ -59,6 +59,14 @@ impl PartBalance {
         }
     }
 
+    /// Set the shifts of `parts` parts of `n` particles (tests: bounds anywhere in their range).
+    #[cfg(test)]
+    pub(crate) fn set(&self, parts: usize, n: usize, shifts: Vec<f64>) {
+        if let Ok(mut s) = self.0.lock() {
+            *s = State { parts, n, shifts };
+        }
+    }
+
     /// Learn from one region over `parts = cost.len()` parts of `n` particles: `cost[p]`
     /// the model cost of part `p`, `time[p]` its time \[s\], `thread[p]` the pool thread
     /// that ran it.
@@ -135,7 +143,11 @@ mod tests {
         // balanced: c0 * 1.0 = (1000 - c0) * 1.2, c0 = 545.45
         let c0 = total * (0.5 + shifts[0]);
         assert!((c0 - 545.4545).abs() < 0.5, "first part's cost {c0}");
-        let again = next_shifts(&shifts, &[c0, total - c0], &[c0 * 1e-6, (total - c0) * 1.2e-6]);
+        let again = next_shifts(
+            &shifts,
+            &[c0, total - c0],
+            &[c0 * 1e-6, (total - c0) * 1.2e-6],
+        );
         assert!((again[0] - shifts[0]).abs() < 1e-4);
     }
 

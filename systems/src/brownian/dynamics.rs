@@ -3,6 +3,8 @@
 //! positions and time), mobility (free draining or a prepared RPY [`Mobility`] over the free
 //! particles), hard cores and capture.
 
+use std::sync::Mutex;
+
 use glam::DVec3;
 use magsep_components::brownian::BrownianStats;
 use magsep_components::brownian::{CaptureEvent, MomentModel};
@@ -188,7 +190,9 @@ impl PipelineDynamics<'_> {
     /// expressions, in the same order per particle, as [`super::stepper::advance`] with
     /// [`StepControl::Fixed`](magsep_components::brownian::StepControl::Fixed) after
     /// [`PipelineDynamics::velocities`] (its reference, tested bit for bit): one parallel region
-    /// over the parts of the pair forces ([`super::parts`]) instead of four.
+    /// over the parts of the pair forces ([`super::parts`]) instead of four. Returns the first
+    /// particle whose new position is not finite (each part checks its own particles, so the
+    /// caller need not scan them again on one thread).
     pub fn fixed_free_step(
         &mut self,
         x: &mut [DVec3],
@@ -196,7 +200,7 @@ impl PipelineDynamics<'_> {
         dt: f64,
         rngs: &mut [Xoshiro256PlusPlus],
         stats: &mut BrownianStats,
-    ) {
+    ) -> Option<usize> {
         let (mobile, radii, eta, kt) =
             (self.mobile.as_slice(), self.radii, self.viscosity, self.kt);
         let (ff, flow) = (self.flow_field, self.flow);
@@ -224,19 +228,34 @@ impl PipelineDynamics<'_> {
             .into_iter()
             .zip(split_at_bounds(&mut rngs[..n], &bounds))
             .collect();
-        let bounds = bounds.as_slice();
+        // per part: its mobile particles and its first non-finite position
+        let found: Vec<Mutex<(u64, Option<usize>)>> =
+            (0..items.len()).map(|_| Mutex::new((0, None))).collect();
+        let (bounds, found_ref) = (bounds.as_slice(), found.as_slice());
         run_parts(items, move |p, (xs, rs)| {
             let a = bounds[p];
             xs.iter_mut()
                 .zip(rs.iter_mut())
                 .enumerate()
                 .for_each(|(k, v)| step((a + k, v)));
+            let moved = mobile[a..a + xs.len()].iter().filter(|&&m| m).count() as u64;
+            let bad = xs.iter().position(|v| !v.is_finite()).map(|k| a + k);
+            if let Some(Ok(mut slot)) = found_ref.get(p).map(Mutex::lock) {
+                *slot = (moved, bad);
+            }
         });
+        let (moved, mut bad) = found
+            .into_iter()
+            .map(|m| m.into_inner().unwrap_or((0, None)))
+            .fold((0, None), |(n, b), (m, c)| (n + m, b.or(c)));
         if let Some(from) = from {
             self.accept(&from, x, 1.0);
+            // a capture may have put a particle somewhere else
+            bad = x.iter().position(|v| !v.is_finite());
         }
         stats.substeps += 1;
-        stats.particle_substeps += self.mobile.iter().filter(|&&m| m).count() as u64;
+        stats.particle_substeps += moved;
+        bad
     }
 }
 

@@ -253,30 +253,7 @@ impl ForceModel {
     ) {
         patches.ensure(x.len());
         if self.sources.is_empty() {
-            // uniform field: a moment depends on the particle's law alone (and no field
-            // force), so consecutive particles of one law share one evaluation. Values
-            // already in place (the usual case: the last step's) are not written again: the
-            // other threads' pair passes read these arrays, and a write would take each cache
-            // line back from their caches
-            let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
-            let mut last: Option<(MomentModel, DVec3)> = None;
-            for (i, (m, f)) in moments.iter_mut().zip(field.iter_mut()).enumerate() {
-                let law = view.moments[i];
-                let v = match last {
-                    Some((l, v)) if l == law => v,
-                    _ => {
-                        let v = self.moment_and_field_force(x, view, i, &mut None).0;
-                        last = Some((law, v));
-                        v
-                    }
-                };
-                if bits(m) != bits(&v) {
-                    *m = v;
-                }
-                if bits(f) != bits(&DVec3::ZERO) {
-                    *f = DVec3::ZERO;
-                }
-            }
+            self.uniform_moments(x, view, 0, moments, field);
             return;
         }
         let go = |(i, ((m, f), slot)): (usize, ((&mut DVec3, &mut DVec3), &mut Option<Patch>))| {
@@ -300,15 +277,87 @@ impl ForceModel {
         }
     }
 
+    /// The moments of the particles `a..a + moments.len()` in a uniform field (no fibres)
+    /// and their (zero) field forces. A moment depends on the particle's law alone, so
+    /// consecutive particles of one law share one evaluation. Values already in place (the
+    /// usual case: the last step's) are not written again: the other threads' pair passes
+    /// read these arrays, and a write would take each cache line back from their caches.
+    fn uniform_moments(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        a: usize,
+        moments: &mut [DVec3],
+        field: &mut [DVec3],
+    ) {
+        let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
+        let mut last: Option<(MomentModel, DVec3)> = None;
+        for (k, (m, f)) in moments.iter_mut().zip(field.iter_mut()).enumerate() {
+            let i = a + k;
+            let law = view.moments[i];
+            let v = match last {
+                Some((l, v)) if l == law => v,
+                _ => {
+                    let v = self.moment_and_field_force(x, view, i, &mut None).0;
+                    last = Some((law, v));
+                    v
+                }
+            };
+            if bits(m) != bits(&v) {
+                *m = v;
+            }
+            if bits(f) != bits(&DVec3::ZERO) {
+                *f = DVec3::ZERO;
+            }
+        }
+    }
+
+    /// The step's start: [`ForceModel::moments_and_field`] and [`ForceModel::update_lists`],
+    /// the moments of a uniform field computed in the parts of the lists' displacement tests
+    /// ([`super::parts::lists_within_skin_and`]: one parallel region for both, instead of a
+    /// serial pass before it). The same values either way.
+    pub fn prepare_step(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        lists: &mut PairLists,
+        moments: &mut [DVec3],
+        field: &mut [DVec3],
+    ) -> u64 {
+        let n = x.len();
+        if !self.sources.is_empty() || moments.len() != n || field.len() != n {
+            self.moments_and_field(x, view, &mut lists.patches, moments, field);
+            return self.update_lists(x, view, lists);
+        }
+        lists.patches.ensure(n);
+        let (dw, cw) =
+            super::parts::lists_within_skin_and(x, lists, (moments, field), |a, m, f| {
+                self.uniform_moments(x, view, a, m, f)
+            });
+        self.ensure_lists(x, view, lists, (dw, cw))
+    }
+
     /// Make the neighbour lists of the particles that exert pair forces serve `x`: one with
     /// the dipole cut-off of the largest pair, one with the Mie range (so contacts do not scan
     /// the dipole neighbourhood). Returns the number of lists rebuilt.
     pub fn update_lists(&self, x: &[DVec3], view: &ParticleView, lists: &mut PairLists) -> u64 {
-        let amax = view.radii.iter().copied().fold(0.0, f64::max);
-        let (dipole, contact) = (self.dipole_range(view), self.contact_range(view));
         // both lists' displacement tests in the parts of the step (each thread reads the
         // positions it wrote)
-        let (dw, cw) = super::parts::lists_within_skin(x, lists);
+        let within = super::parts::lists_within_skin(x, lists);
+        self.ensure_lists(x, view, lists, within)
+    }
+
+    /// [`ForceModel::update_lists`] after the displacement tests (`within` of the dipole and
+    /// the contact list, see [`super::verlet::VerletList::ensure_checked`]).
+    fn ensure_lists(
+        &self,
+        x: &[DVec3],
+        view: &ParticleView,
+        lists: &mut PairLists,
+        (dw, cw): (Option<bool>, Option<bool>),
+    ) -> u64 {
+        let amax = view.radii.iter().copied().fold(0.0, f64::max);
+        let (dipole, contact) = (self.dipole_range(view), self.contact_range(view));
         let mut rebuilt = 0;
         let mut ensure = |list: &mut VerletList, range: f64, within: Option<bool>| {
             if range > 0.0 && range.is_finite() {

@@ -178,6 +178,72 @@ fn the_fused_pair_pass_equals_the_separate_passes_bit_for_bit() {
                 bits(&fc) == bits(&c),
                 "contact, {threads} threads, {interact}"
             );
+            // bounds moved as far as the learnt balance moves them, either way: the same bits
+            for sign in [-1.0, 1.0] {
+                let shift = sign * 0.4 / threads as f64;
+                lists.balance.set(threads, n, vec![shift; threads - 1]);
+                let (mut sd, mut sc) = (vec![DVec3::X; n], vec![DVec3::X; n]);
+                pool.install(|| model.pair_forces(&x, &moments, &view, &lists, (&mut sd, &mut sc)));
+                assert!(
+                    bits(&sd) == bits(&d) && bits(&sc) == bits(&c),
+                    "shift {shift}"
+                );
+            }
+            lists.balance.set(threads, n, Vec::new());
         }
+    }
+}
+
+/// The step's start with a uniform field's moments in the parts of the lists' displacement
+/// tests gives the moments, field forces and lists of the two separate calls, on one and two
+/// threads (a first call that builds the lists, a second that they serve).
+#[test]
+fn the_fused_step_start_equals_the_separate_calls() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let n = 2100;
+    let x = positions_in_box(&mut rng, n, 3.0e-6);
+    let model = uniform_field_model(
+        DVec3::new(0.0, 0.3, 1.0),
+        Some(Mie::new(4e-21, 12.0, 6.0)),
+        8.0,
+    );
+    // runs of laws, some non-magnetic
+    let laws: Vec<MomentModel> = (0..n)
+        .map(|i| match (i / 300) % 3 {
+            0 => MomentModel::Saturated { moment: 1e-17 },
+            1 => MomentModel::None,
+            _ => MomentModel::Saturated { moment: 2e-17 },
+        })
+        .collect();
+    let radii = vec![75e-9; n];
+    let mobile = vec![true; n];
+    let exerts = vec![true; n];
+    let view = ParticleView {
+        radii: &radii,
+        moments: &laws,
+        mobile: &mobile,
+        exerts: &exerts,
+    };
+    let mut reference = PairLists::default();
+    let (mut m0, mut f0) = (vec![DVec3::ZERO; n], vec![DVec3::X; n]);
+    model.moments_and_field(&x, &view, &mut reference.patches, &mut m0, &mut f0);
+    let builds = model.update_lists(&x, &view, &mut reference);
+    assert_eq!(builds, 2);
+    assert_eq!(m0.iter().filter(|m| **m == DVec3::ZERO).count(), 600);
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut lists = PairLists::default();
+        let (mut m, mut f) = (vec![DVec3::Y; n], vec![DVec3::X; n]);
+        // the first call builds the lists, the second finds them serving
+        for round in 0..2 {
+            let built = pool.install(|| model.prepare_step(&x, &view, &mut lists, &mut m, &mut f));
+            assert_eq!(built, if round == 0 { 2 } else { 0 }, "{threads} threads");
+            assert_eq!(m, m0, "moments, {threads} threads, round {round}");
+            assert_eq!(f, f0, "field forces, {threads} threads, round {round}");
+        }
+        assert_eq!(lists.dipole.pair_count(), reference.dipole.pair_count());
     }
 }

@@ -80,8 +80,9 @@ pub fn shifted_bounds(
 /// The parts of `n` particles for the pair lists `lists` ([`part_count`] of them): about
 /// equal dipole pairs owned (the pair pass, weighted twice), list entries (the gathers) and
 /// particles (the update). Every phase of a step asks for these same bounds.
-/// The bounds are moved from the cost model's by the shifts the lists' [`PartBalance`](super::balance::PartBalance) learnt
-/// from the pair pass's part times ([`super::balance`]).
+///
+/// The bounds are moved from the cost model's by the shifts that the lists'
+/// [`PartBalance`](super::balance::PartBalance) learnt from the pair pass's part times.
 pub fn part_bounds(lists: &PairLists, n: usize) -> Vec<usize> {
     let parts = part_count(n);
     let shifts = lists.balance.shifts(parts, n);
@@ -98,13 +99,38 @@ fn part_cost_before(lists: &PairLists, i: usize) -> u64 {
 /// in the parts of the step, one parallel region for both (None, None: one part, the lists
 /// test on the calling thread).
 pub fn lists_within_skin(x: &[DVec3], lists: &PairLists) -> (Option<bool>, Option<bool>) {
+    lists_within_skin_and(x, lists, (&mut [], &mut []), |_, _, _| {})
+}
+
+/// [`lists_within_skin`], and in the same region `also(a, m, f)` for each part `a..b` with
+/// `m` and `f` that part's slices of `values` (used for the moments of a uniform field, see
+/// [`ForceModel::prepare_step`]; empty `values` give empty slices).
+pub fn lists_within_skin_and(
+    x: &[DVec3],
+    lists: &PairLists,
+    values: (&mut [DVec3], &mut [DVec3]),
+    also: impl Fn(usize, &mut [DVec3], &mut [DVec3]) + Sync + Clone,
+) -> (Option<bool>, Option<bool>) {
     let bounds = part_bounds(lists, x.len());
     if bounds.len() <= 2 {
+        also(0, values.0, values.1);
         return (None, None);
     }
     let (dipole, contact) = (AtomicBool::new(true), AtomicBool::new(true));
     let (d, c, b) = (&dipole, &contact, bounds.as_slice());
-    run_parts(vec![(); bounds.len() - 1], move |p, ()| {
+    let value_bounds = |v: &[DVec3]| -> Vec<usize> {
+        match v.len() {
+            0 => vec![0; bounds.len()],
+            _ => bounds.to_vec(),
+        }
+    };
+    let (mb, fb) = (value_bounds(values.0), value_bounds(values.1));
+    let items: Vec<_> = split_at_bounds(values.0, &mb)
+        .into_iter()
+        .zip(split_at_bounds(values.1, &fb))
+        .collect();
+    run_parts(items, move |p, (m, f)| {
+        also(b[p], m, f);
         if !lists.dipole.within_skin(x, b[p], b[p + 1]) {
             d.store(false, Ordering::Relaxed);
         }

@@ -292,10 +292,10 @@ pub fn prepare_brownian_step(
     );
     m.resize(n, DVec3::ZERO);
     f.resize(n, DVec3::ZERO);
-    ws.model
-        .moments_and_field(&ws.positions, &view, &mut ws.lists.patches, &mut m, &mut f);
+    stats.neighbour_list_builds +=
+        ws.model
+            .prepare_step(&ws.positions, &view, &mut ws.lists, &mut m, &mut f);
     (ws.moments, ws.field) = (m, f);
-    stats.neighbour_list_builds += ws.model.update_lists(&ws.positions, &view, &mut ws.lists);
     let (mut d, mut c) = (
         std::mem::take(&mut ws.dipole),
         std::mem::take(&mut ws.contact),
@@ -472,12 +472,14 @@ pub fn integrate_brownian(
         failure: None,
     };
     let mut x = std::mem::take(&mut ws.positions);
+    // the first non-finite position (the fused step finds it in its parts)
+    let mut scanned = None;
     if fused {
-        if from_components {
-            dynamics.fixed_free_step(&mut x, |k| net[k], clock.dt, &mut ws.rngs, &mut stats);
+        scanned = Some(if from_components {
+            dynamics.fixed_free_step(&mut x, |k| net[k], clock.dt, &mut ws.rngs, &mut stats)
         } else {
-            dynamics.fixed_free_step(&mut x, net_of, clock.dt, &mut ws.rngs, &mut stats);
-        }
+            dynamics.fixed_free_step(&mut x, net_of, clock.dt, &mut ws.rngs, &mut stats)
+        });
     } else {
         if !from_components {
             net = (0..n).map(net_of).collect();
@@ -519,7 +521,8 @@ pub fn integrate_brownian(
     for (i, ev) in captures {
         ws.captured[i] = Some(ev);
     }
-    if let Some(i) = x.iter().position(|p| !p.is_finite()) {
+    let bad = scanned.unwrap_or_else(|| x.iter().position(|p| !p.is_finite()));
+    if let Some(i) = bad {
         health.report(format!(
             "step {}: non-finite position of particle {i} (time step unstable?)",
             clock.step
