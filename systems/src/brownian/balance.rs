@@ -2,10 +2,13 @@
 //!
 //! [`super::parts::part_bounds`] splits the particles by a cost model (list entries, owned
 //! pairs, particles). The model misses what each part really pays: the part after a bound
-//! recomputes the pairs that straddle it (their owner is in the part before), and a part's
-//! memory traffic depends on where its particles are. Measured on the 10⁴-particle mirror of
-//! the LAMMPS Brownian bench (2 threads), the second part's pair pass took 9-11 % longer than
-//! the first and its update 12-15 % longer, so at every step one thread waited for the other.
+//! recomputes the pairs that straddle it (their owner is in the part before), a part's memory
+//! traffic depends on where its particles are, and on a shared virtual machine one core can run
+//! slower than the other for seconds at a time (on the 2-core machine of the benchmarks, the
+//! same single-thread run of the LAMMPS-mirror scene took 2.3-2.6 s pinned to one core and
+//! 2.4-3.1 s pinned to the other, alternated). With the bounds of the model, one part of the
+//! mirror's pair pass took 9-11 % longer than the other at every step, and its thread's
+//! partner waited.
 //!
 //! [`PartBalance`] keeps, per bound, a shift of its cost target (a fraction of the total
 //! cost), learnt from each pair region's part times ([`next_shifts`]): at every bound, the
@@ -15,8 +18,9 @@
 //! times differ by more than a factor 3 (a thread preempted) teach nothing.
 //!
 //! Every kernel split into parts computes each particle's values in a fixed order, so the
-//! results are bitwise the same for any bounds: the bounds move with the machine's timing,
-//! the trajectory does not (tested in `tests/it/brownian_pipeline.rs` across thread counts).
+//! results are bitwise the same for any bounds: the bounds move with the machine's timing, the
+//! trajectory does not (tested with bounds shifted to either clamp in the model's tests, and
+//! across thread counts in `tests/it/brownian_pipeline.rs`).
 
 use std::sync::Mutex;
 
