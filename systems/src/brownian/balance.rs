@@ -97,8 +97,8 @@ impl PartBalance {
 
 /// The bound shifts after one observation: at each inner bound `b` (between parts `b - 1`
 /// and `b`), the cost split of the two parts that equalises their times at their measured
-/// time per cost, a [`DAMPING`] share of the way from the current one, as a fraction of the
-/// total cost, clamped to ±[`MAX_SHIFT`] / parts. Bounds whose parts were not measured
+/// time per cost, a quarter of the way from the current one, as a fraction of the total
+/// cost, clamped to ±0.4 / parts. Bounds whose parts were not measured
 /// properly keep their shift.
 pub fn next_shifts(shifts: &[f64], cost: &[f64], time: &[f64]) -> Vec<f64> {
     let parts = cost.len();
