@@ -19,10 +19,11 @@
 //! then constant between breakpoints). Cylinders wholly inside or wholly
 //! outside the box are decided from their bounding boxes first (2πR²L or 0, no quadrature).
 //!
-//! The fibres are taken not to overlap one another inside the box: their volumes inside it
-//! are summed, so a part common to two fibres would be subtracted twice (fibres from a
-//! packing overlap by at most its tolerance, 1e-4 diameters). The fibres are not dilated by
-//! the particle radius: the volume is the box's fluid volume, not its centres' room.
+//! Fibres may overlap one another (crossing fibres of a hand-written mesh, the contacts of a
+//! packing): the volume of their union inside the box is the sum of their volumes less the
+//! parts they share, by inclusion–exclusion over the groups of fibres that all overlap one
+//! another ([`super::box_overlap`]). The fibres are not dilated by the particle radius: the
+//! volume is the box's fluid volume, not its centres' room.
 //! Hand-written rather than a mesh boolean from a geometry crate: the section areas are
 //! closed-form and the only numerics is a 1-D quadrature of known accuracy.
 
@@ -106,16 +107,21 @@ pub(crate) fn inside_fibre_message(k: usize, radius: &str) -> String {
 }
 
 /// Volume \[m³\] of the box `lo`..`hi` \[m\] outside the fibres (0 when less than 1e-12 of
-/// the box is left; see the module header for the method, its accuracy and the non-overlap
-/// assumption).
+/// the box is left; see the module header for the method, its accuracy and overlapping
+/// fibres).
 pub(crate) fn box_volume_outside_fibres(lo: DVec3, hi: DVec3, fibres: &[FibreSpec]) -> f64 {
     let whole = (hi - lo).element_product();
-    let inside: f64 = fibres
-        .iter()
-        .filter_map(Cylinder::of)
-        .map(|c| cylinder_volume_in_box(&c, lo, hi))
-        .sum();
-    let left = whole - inside;
+    let mut present = Vec::new();
+    let mut inside = 0.0;
+    for c in fibres.iter().filter_map(Cylinder::of) {
+        let v = cylinder_volume_in_box(&c, lo, hi);
+        if v > 0.0 {
+            present.push(c);
+            inside += v;
+        }
+    }
+    // the parts common to overlapping fibres, counted once
+    let left = whole - inside + super::box_overlap::shared_volume_in_box(&present, lo, hi);
     // a box inside a fibre leaves rounding (1e-16 of the box) behind: nothing
     if left > 1e-12 * whole { left } else { 0.0 }
 }
@@ -214,7 +220,7 @@ fn rim_events(c: &Cylinder, lo: DVec3, hi: DVec3) -> Vec<f64> {
 const MAX_PIECES: u32 = 100_000;
 
 /// 5-point Gauss–Legendre estimate of ∫_a^b f.
-fn gauss5(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+pub(super) fn gauss5(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     const X: [f64; 3] = [0.0, 0.538_469_310_105_683_1, 0.906_179_845_938_664];
     const W: [f64; 3] = [
         0.568_888_888_888_888_9,
@@ -231,7 +237,7 @@ fn gauss5(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 
 /// ∫_a^b f by bisection until the halves agree with `whole` (its estimate) within `tol`, at
 /// most `depth` levels deep and `budget` bisections in all (then the halves are taken).
-fn adaptive(
+pub(super) fn adaptive(
     f: &impl Fn(f64) -> f64,
     (a, b): (f64, f64),
     whole: f64,

@@ -16,6 +16,7 @@
 //! assert_eq!(errors.0[0].path, "particles[0].shape.radius");
 //! ```
 
+pub(crate) mod box_overlap;
 pub(crate) mod box_region;
 pub mod checks;
 mod fibre_pack;

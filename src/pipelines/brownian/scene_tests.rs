@@ -191,3 +191,29 @@ fn a_box_region_volume_leaves_out_the_fibre_inside_it() {
         .expect("an error at the placement");
     assert!(hit.message.contains("inside fibre 0"), "{}", hit.message);
 }
+
+#[test]
+fn crossing_fibres_are_left_out_of_a_box_region_once() {
+    // a second fibre of the same radius along x crosses the first (axis z) at the origin,
+    // inside the box: their common part is Steinmetz's solid 16 R³ / 3, subtracted once
+    let text = GOOD
+        .replace(
+            "placement = { kind = \"fibre_top\", fibre = 0, gap = 1e-6, height = 300e-6 }",
+            "placement = { kind = \"box\", min = [-1e-3, -1e-3, -2e-3], max = [1e-3, 1e-3, 2e-3] }",
+        )
+        .replace(
+            "[brownian]",
+            "[[fibres]]\nkind = \"cylinder\"\nradius = 300e-6\nhalf_length = 6e-3\naxis = [1.0, 0.0, 0.0]\nsaturation_magnetisation = 985e3\n[brownian]",
+        );
+    let s = parse_scene(&text, &Default::default()).unwrap();
+    assert_eq!(s.fibres.len(), 2);
+    let v = s.particles[0]
+        .placement
+        .as_ref()
+        .unwrap()
+        .volume(&s.fibres)
+        .unwrap();
+    let (pi, r) = (std::f64::consts::PI, 300e-6f64);
+    let exact = 2e-3 * 2e-3 * 4e-3 - pi * r * r * 4e-3 - pi * r * r * 2e-3 + 16.0 * r.powi(3) / 3.0;
+    assert!((v - exact).abs() < 1e-10 * exact, "{v} against {exact}");
+}
