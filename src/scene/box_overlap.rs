@@ -391,20 +391,8 @@ mod tests {
         let b = cyl([0.0, 0.05, 0.0], [0.2, 1.0, -0.4], 0.25, 1.0);
         let (lo, hi) = (DVec3::new(-0.2, -0.15, -0.1), DVec3::new(0.5, 0.4, 0.3));
         let v = intersection_volume_in_box(&[a, b], lo, hi);
-        let n = 160;
-        let h = (hi - lo) / n as f64;
-        let mut count = 0u64;
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let p = lo + h * DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
-                    if a.distance(p) == 0.0 && b.distance(p) == 0.0 {
-                        count += 1;
-                    }
-                }
-            }
-        }
-        let grid = count as f64 * h.element_product();
+        let both = |p: DVec3| a.distance(p) == 0.0 && b.distance(p) == 0.0;
+        let grid = crate::scene::box_region::tests::grid_volume(lo, hi, 160, both);
         assert!(
             v > 0.0 && rel(v, grid) < 5e-3,
             "quadrature {v}, grid {grid}"

@@ -323,7 +323,7 @@ fn disc_triangle(a: DVec2, b: DVec2, r: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use std::f64::consts::PI;
 
@@ -411,18 +411,7 @@ mod tests {
             half_length: 1.2e-3,
         };
         let v = cylinder_volume_in_box(&c, LO, HI);
-        let n = 300usize;
-        let size = (HI - LO) / n as f64;
-        let mut count = 0u64;
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let p = LO + size * DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
-                    count += u64::from(c.distance(p) == 0.0);
-                }
-            }
-        }
-        let reference = count as f64 * size.element_product();
+        let reference = grid_volume(LO, HI, 300, |p| c.distance(p) == 0.0);
         // the grid's error: its cells along the surface, ~ area * cell / volume ~ 1e-3 here
         assert!(rel(v, reference) < 3e-3, "{v} against {reference}");
         assert!(v > 0.0 && v < PI * c.radius.powi(2) * 2.0 * c.half_length);
@@ -435,6 +424,27 @@ mod tests {
 
     /// The part of `c` inside the box `LO`..`HI` by the simple rule: 5-point Gauss-Legendre on
     /// 20 000 equal pieces of the whole length, no breakpoints.
+    /// Midpoint-rule volume \[m³\] of the points of the box `lo`..`hi` where `inside` holds,
+    /// on a grid of `n`³ cells (each cell's centre inside or not): the tests' reference.
+    pub(in crate::scene) fn grid_volume(
+        lo: DVec3,
+        hi: DVec3,
+        n: usize,
+        inside: impl Fn(DVec3) -> bool,
+    ) -> f64 {
+        let size = (hi - lo) / n as f64;
+        let mut count = 0u64;
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let p = lo + size * DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
+                    count += u64::from(inside(p));
+                }
+            }
+        }
+        count as f64 * size.element_product()
+    }
+
     fn composite(c: &Cylinder) -> f64 {
         let (u, w) = c.axis.any_orthonormal_pair();
         let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);

@@ -47,20 +47,10 @@ fn good_scene_parses_with_defaults_and_region_volumes() {
     assert_eq!(c.dipole_cutoff, Some(30.0));
     assert_eq!(c.observe_every, 100);
     assert_eq!(b.runs(), 3);
-    let top = s.particles[0]
-        .placement
-        .as_ref()
-        .unwrap()
-        .volume(&s.fibres)
-        .unwrap();
+    let top = region_volume(&s, 0);
     let pi = std::f64::consts::PI;
     assert!((top - pi * 300e-6f64.powi(2) * 300e-6).abs() < 1e-20);
-    let side = s.particles[1]
-        .placement
-        .as_ref()
-        .unwrap()
-        .volume(&s.fibres)
-        .unwrap();
+    let side = region_volume(&s, 1);
     let (r0, r1) = (301e-6f64, 601e-6f64);
     assert!((side - pi * (r1 * r1 - r0 * r0) * 12e-3).abs() < 1e-18);
 }
@@ -170,12 +160,7 @@ fn a_box_region_volume_leaves_out_the_fibre_inside_it() {
         "placement = { kind = \"box\", min = [-1e-3, -1e-3, -2e-3], max = [1e-3, 1e-3, 2e-3] }",
     );
     let s = parse_scene(&text, &Default::default()).unwrap();
-    let v = s.particles[0]
-        .placement
-        .as_ref()
-        .unwrap()
-        .volume(&s.fibres)
-        .unwrap();
+    let v = region_volume(&s, 0);
     let pi = std::f64::consts::PI;
     let exact = 2e-3 * 2e-3 * 4e-3 - pi * 300e-6f64.powi(2) * 4e-3;
     assert!((v - exact).abs() < 1e-13 * exact, "{v} against {exact}");
@@ -207,13 +192,18 @@ fn crossing_fibres_are_left_out_of_a_box_region_once() {
         );
     let s = parse_scene(&text, &Default::default()).unwrap();
     assert_eq!(s.fibres.len(), 2);
-    let v = s.particles[0]
+    let v = region_volume(&s, 0);
+    let (pi, r) = (std::f64::consts::PI, 300e-6f64);
+    let exact = 2e-3 * 2e-3 * 4e-3 - pi * r * r * 4e-3 - pi * r * r * 2e-3 + 16.0 * r.powi(3) / 3.0;
+    assert!((v - exact).abs() < 1e-10 * exact, "{v} against {exact}");
+}
+
+/// The region volume \[m³\] of the scene's particle group `k`.
+fn region_volume(s: &Scene, k: usize) -> f64 {
+    s.particles[k]
         .placement
         .as_ref()
         .unwrap()
         .volume(&s.fibres)
-        .unwrap();
-    let (pi, r) = (std::f64::consts::PI, 300e-6f64);
-    let exact = 2e-3 * 2e-3 * 4e-3 - pi * r * r * 4e-3 - pi * r * r * 2e-3 + 16.0 * r.powi(3) / 3.0;
-    assert!((v - exact).abs() < 1e-10 * exact, "{v} against {exact}");
+        .unwrap()
 }
