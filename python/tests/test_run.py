@@ -119,7 +119,10 @@ def test_ctrl_c_stops_the_run_gracefully(tmp_path):
     rec = tmp_path / "stopped.mcap"
     script = textwrap.dedent(
         f"""
-        import json, sys, magsep
+        import json, signal, sys, magsep
+        # Ctrl-C's Python handler even when the parent ignores SIGINT (a background job of a
+        # non-interactive shell passes SIG_IGN on, and Python then installs no handler)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("ready", flush=True)
         try:
             magsep.run({str(ROOT / 'tests/data/packing_long.toml')!r}, record={str(rec)!r})
