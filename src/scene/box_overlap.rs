@@ -139,23 +139,23 @@ pub(crate) fn intersection_volume_in_box(cs: &[Cylinder], lo: DVec3, hi: DVec3) 
     let (e, r) = (first.axis, first.radius);
     // the axis range that can meet the box and every other cylinder
     let (mut a, mut b) = (-first.half_length, first.half_length);
-    let span = (hi - lo).length();
-    let box_mid = Cylinder {
-        center: 0.5 * (lo + hi),
-        axis: DVec3::X,
-        radius: 0.0,
-        half_length: 0.0,
-    };
-    for (other, reach) in others
-        .iter()
-        .map(|o| (o, r + o.radius))
-        .chain(std::iter::once((&box_mid, r + 0.5 * span)))
-    {
-        match axis_range_near(first, other, reach) {
+    for other in others {
+        match axis_range_near(first, other, r + other.radius) {
             Some((t0, t1)) => (a, b) = (a.max(t0), b.min(t1)),
             None => return 0.0,
         }
     }
+    // the box lies in the ball about its middle of radius its half diagonal: the axis points
+    // within r of that ball
+    let reach = r + 0.5 * (hi - lo).length();
+    let d = first.center - 0.5 * (lo + hi);
+    let along = d.dot(e);
+    let across2 = d.length_squared() - along * along;
+    if across2 > reach * reach {
+        return 0.0;
+    }
+    let half = (reach * reach - across2).max(0.0).sqrt();
+    (a, b) = (a.max(-along - half), b.min(-along + half));
     if a.is_nan() || b.is_nan() || b <= a {
         return 0.0;
     }

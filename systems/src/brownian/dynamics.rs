@@ -3,8 +3,6 @@
 //! positions and time), mobility (free draining or a prepared RPY [`Mobility`] over the free
 //! particles), hard cores and capture.
 
-use std::sync::Mutex;
-
 use glam::DVec3;
 use magsep_components::brownian::BrownianStats;
 use magsep_components::brownian::{CaptureEvent, MomentModel};
@@ -229,10 +227,8 @@ impl PipelineDynamics<'_> {
             .zip(split_at_bounds(&mut rngs[..n], &bounds))
             .collect();
         // per part: its mobile particles and its first non-finite position
-        let found: Vec<Mutex<(u64, Option<usize>)>> =
-            (0..items.len()).map(|_| Mutex::new((0, None))).collect();
-        let (bounds, found_ref) = (bounds.as_slice(), found.as_slice());
-        run_parts(items, move |p, (xs, rs)| {
+        let bounds = bounds.as_slice();
+        let found = run_parts(items, move |p, (xs, rs)| {
             let a = bounds[p];
             xs.iter_mut()
                 .zip(rs.iter_mut())
@@ -240,13 +236,10 @@ impl PipelineDynamics<'_> {
                 .for_each(|(k, v)| step((a + k, v)));
             let moved = mobile[a..a + xs.len()].iter().filter(|&&m| m).count() as u64;
             let bad = xs.iter().position(|v| !v.is_finite()).map(|k| a + k);
-            if let Some(Ok(mut slot)) = found_ref.get(p).map(Mutex::lock) {
-                *slot = (moved, bad);
-            }
+            (moved, bad)
         });
         let (moved, mut bad) = found
             .into_iter()
-            .map(|m| m.into_inner().unwrap_or((0, None)))
             .fold((0, None), |(n, b), (m, c)| (n + m, b.or(c)));
         if let Some(from) = from {
             self.accept(&from, x, 1.0);

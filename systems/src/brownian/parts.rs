@@ -41,13 +41,9 @@ pub fn part_count(n: usize) -> usize {
 }
 
 /// `parts + 1` bounds splitting `0..n` into contiguous parts of about equal cost, where
-/// `prefix(i)` is the (nondecreasing) cost of the particles `0..i`.
-pub fn balanced_bounds(n: usize, parts: usize, prefix: impl Fn(usize) -> u64) -> Vec<usize> {
-    shifted_bounds(n, parts, &[], prefix)
-}
-
-/// [`balanced_bounds`] with the cost target of inner bound `p` (1-based) moved by
-/// `shifts[p - 1]` times the total cost (see [`super::balance`]; missing shifts are zero).
+/// `prefix(i)` is the (nondecreasing) cost of the particles `0..i`, with the cost target of
+/// inner bound `p` (1-based) moved by `shifts[p - 1]` times the total cost (see
+/// [`super::balance`]; missing shifts are zero).
 pub fn shifted_bounds(
     n: usize,
     parts: usize,
@@ -118,16 +114,10 @@ pub fn lists_within_skin_and(
     }
     let (dipole, contact) = (AtomicBool::new(true), AtomicBool::new(true));
     let (d, c, b) = (&dipole, &contact, bounds.as_slice());
-    let value_bounds = |v: &[DVec3]| -> Vec<usize> {
-        match v.len() {
-            0 => vec![0; bounds.len()],
-            _ => bounds.to_vec(),
-        }
-    };
-    let (mb, fb) = (value_bounds(values.0), value_bounds(values.1));
-    let items: Vec<_> = split_at_bounds(values.0, &mb)
+    // empty `values` split into empty parts (`split_at_bounds` clamps)
+    let items: Vec<_> = split_at_bounds(values.0, b)
         .into_iter()
-        .zip(split_at_bounds(values.1, &fb))
+        .zip(split_at_bounds(values.1, b))
         .collect();
     run_parts(items, move |p, (m, f)| {
         also(b[p], m, f);
@@ -143,32 +133,44 @@ pub fn lists_within_skin_and(
 
 /// `f(p, item)` for every part `p` and its item, one part per pool thread: thread `t` takes
 /// part `t mod parts` first, then any part nobody has taken. One part runs on the calling
-/// thread.
+/// thread. Returns each part's result, in part order.
 ///
 /// Each thread runs its own copy of `f`: a closure's captures live in the calling thread's
 /// stack frame, in cache lines that thread keeps writing while it runs its own part, and the
 /// other thread reading them there at every particle took its update 3.7 times its 1-thread
 /// CPU time (capture by `move` so that the copy holds the values, not references to them).
-pub fn run_parts<T: Send>(items: Vec<T>, f: impl Fn(usize, T) + Sync + Clone) {
+pub fn run_parts<T: Send, R: Send>(
+    items: Vec<T>,
+    f: impl Fn(usize, T) -> R + Sync + Clone,
+) -> Vec<R> {
     let parts = items.len();
     if parts <= 1 {
-        items.into_iter().for_each(|t| f(0, t));
-        return;
+        return items.into_iter().map(|t| f(0, t)).collect();
     }
     let slots: Vec<Mutex<Option<T>>> = items.into_iter().map(|t| Mutex::new(Some(t))).collect();
+    let done: Vec<Mutex<Option<R>>> = (0..parts).map(|_| Mutex::new(None)).collect();
     let take = |p: usize| slots[p].lock().ok().and_then(|mut g| g.take());
+    let put = |p: usize, r: R| {
+        if let Ok(mut g) = done[p].lock() {
+            *g = Some(r);
+        }
+    };
     (0..parts).into_par_iter().with_max_len(1).for_each(|_| {
         let f = std::hint::black_box(f.clone());
         let own = rayon::current_thread_index().unwrap_or(0) % parts;
         if let Some(t) = take(own) {
-            f(own, t);
+            put(own, f(own, t));
         }
         for p in 0..parts {
             if let Some(t) = take(p) {
-                f(p, t);
+                put(p, f(p, t));
             }
         }
     });
+    // every part ran exactly once (a panic in `f` propagates out of the region)
+    done.into_iter()
+        .filter_map(|m| m.into_inner().ok().flatten())
+        .collect()
 }
 
 /// Split `v` at `bounds` (ascending, the last no more than `v.len()`) into mutable parts.
@@ -215,8 +217,7 @@ pub fn pair_forces_in_parts(
         .collect();
     let range = model.contact_range(view);
     // each part's time and thread, for the balance of the bounds
-    let clocks: Vec<Mutex<(f64, usize)>> = (0..items.len()).map(|_| Mutex::new((0.0, 0))).collect();
-    run_parts(items, |p, ((own, d), c)| {
+    let clocks = run_parts(items, |p, ((own, d), c)| {
         let started = Instant::now();
         let (a, b) = (bounds[p], bounds[p + 1]);
         let base = slot_bounds[p];
@@ -265,19 +266,14 @@ pub fn pair_forces_in_parts(
             };
             c[i - a] = model.contact_force_on(x, view, lists, range, i);
         }
-        if let Some(Ok(mut clock)) = clocks.get(p).map(Mutex::lock) {
-            let thread = rayon::current_thread_index().unwrap_or(usize::MAX);
-            *clock = (started.elapsed().as_secs_f64(), thread);
-        }
+        let thread = rayon::current_thread_index().unwrap_or(usize::MAX);
+        (started.elapsed().as_secs_f64(), thread)
     });
     if cut.is_some() {
         lists.pair_scratch.put(pf);
     }
     if bounds.len() > 2 {
-        let (time, thread): (Vec<f64>, Vec<usize>) = clocks
-            .into_iter()
-            .map(|c| c.into_inner().unwrap_or((0.0, usize::MAX)))
-            .unzip();
+        let (time, thread): (Vec<f64>, Vec<usize>) = clocks.into_iter().unzip();
         let cost: Vec<u64> = bounds
             .windows(2)
             .map(|w| part_cost_before(lists, w[1]) - part_cost_before(lists, w[0]))
@@ -294,16 +290,16 @@ mod tests {
     fn bounds_split_the_cost_evenly_and_cover_every_particle() {
         // the first 100 particles cost 10 each, the other 900 one each: 1900 in all
         let prefix = |i: usize| (10 * i.min(100) + i.saturating_sub(100)) as u64;
-        assert_eq!(balanced_bounds(1000, 2, prefix), vec![0, 95, 1000]);
-        let b = balanced_bounds(1000, 4, prefix);
+        assert_eq!(shifted_bounds(1000, 2, &[], prefix), vec![0, 95, 1000]);
+        let b = shifted_bounds(1000, 4, &[], prefix);
         assert_eq!((b[0], b[4]), (0, 1000));
         assert!(b.windows(2).all(|w| w[0] <= w[1]));
         for p in 0..4 {
             let cost = prefix(b[p + 1]) - prefix(b[p]);
             assert!((470..=480).contains(&cost), "part {p}: {cost}");
         }
-        assert_eq!(balanced_bounds(0, 3, prefix), vec![0, 0, 0, 0]);
-        assert_eq!(balanced_bounds(5, 1, prefix), vec![0, 5]);
+        assert_eq!(shifted_bounds(0, 3, &[], prefix), vec![0, 0, 0, 0]);
+        assert_eq!(shifted_bounds(5, 1, &[], prefix), vec![0, 5]);
     }
 
     #[test]

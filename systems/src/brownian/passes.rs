@@ -69,16 +69,11 @@ pub fn write_back_in_parts(
         }
         None => &mut [],
     };
-    // no capture flags (no `Captured` in the table): empty parts
-    let cap_bounds = if cap.is_empty() {
-        vec![0; bounds.len()]
-    } else {
-        bounds.to_vec()
-    };
+    // no capture flags (no `Captured` in the table): empty parts (`split_at_bounds` clamps)
     let items: Vec<_> = split_at_bounds(pos.bypass_change_detection(), bounds)
         .into_iter()
         .zip(split_at_bounds(rng.bypass_change_detection(), bounds))
-        .zip(split_at_bounds(cap, &cap_bounds))
+        .zip(split_at_bounds(cap, bounds))
         .collect();
     let (x, captured, rngs) = (
         ws.positions.as_slice(),
