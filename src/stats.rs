@@ -7,7 +7,6 @@
 //! undefined: `None` (JSON `null`), never 0, so that a summary cannot report a statistic of
 //! nothing as a measured zero.
 
-use statrs::distribution::{ContinuousCDF, StudentsT};
 use statrs::statistics::Statistics;
 
 /// The mean of `xs`, `None` when `xs` is empty.
@@ -24,8 +23,9 @@ pub fn mean_sd(xs: &[f64]) -> (Option<f64>, Option<f64>) {
 
 /// The mean of `ys` (the plain sum over n: NaN for no values) and the half-width of its
 /// 95 % confidence interval, t_{0.975, n−1} s / √n with the sample variance s² (n − 1 in the
-/// denominator) and `statrs`' Student-t quantile; `None` for fewer than two values (one
-/// value has no interval).
+/// denominator) and `statrs`' Student-t quantile, by the packing analysis's
+/// [`mean_interval_95`](magsep_systems::analysis::confinement::mean_interval_95); `None` for
+/// fewer than two values (one value has no interval).
 ///
 /// ```
 /// use magsep::stats::mean_ci95;
@@ -35,16 +35,11 @@ pub fn mean_sd(xs: &[f64]) -> (Option<f64>, Option<f64>) {
 /// assert_eq!(mean_ci95(&[3.0]), (3.0, None));
 /// ```
 pub fn mean_ci95(ys: &[f64]) -> (f64, Option<f64>) {
-    let n = ys.len() as f64;
-    let mean = ys.iter().sum::<f64>() / n;
-    if ys.len() < 2 {
-        return (mean, None);
+    // the one sample-mean interval of the project: the packing analysis's
+    match magsep_systems::analysis::confinement::mean_interval_95(ys) {
+        Some(m) => (m.mean, Some(m.half_width)),
+        None => (ys.iter().sum::<f64>() / ys.len() as f64, None),
     }
-    let var = ys.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    let t = StudentsT::new(0.0, 1.0, n - 1.0)
-        .map(|d| d.inverse_cdf(0.975))
-        .unwrap_or(f64::NAN);
-    (mean, Some(t * (var / n).sqrt()))
 }
 
 #[cfg(test)]

@@ -101,7 +101,7 @@ pub use frame::{
 pub use reader::{
     ChannelInfo, Frames, LastFrame, MAX_CHUNK_BYTES, Messages, MetadataRecord, RATIO_FREE_BYTES,
     RawMessage, ReadMode, ReaderLimits, Recording, RecordingReader, SchemaInfo, open_regular,
-    read_last_frame, read_recording, read_recording_bytes, trailing_message,
+    read_last_frame, read_recording, read_recording_bytes, stops_reading, trailing_message,
 };
 pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
 pub use writer::{ChannelHandle, FrameBuffering, RecordingSink, RecordingWriter, log_time_ns};
@@ -163,12 +163,40 @@ pub enum RecordError {
         /// What failed, with the byte offset of the record concerned.
         detail: String,
     },
+    /// Chunks whose bytes are damaged (a CRC mismatch, data that does not decompress or does
+    /// not split into records) were skipped, and the records before and after them read: the
+    /// messages in those chunks are missing. Given once, after every message read.
+    #[error(
+        "corrupt recording at byte {offset}: {detail}; that chunk was skipped and the rest of \
+         the file read ({count} damaged chunk(s) skipped in all)"
+    )]
+    SkippedChunks {
+        /// Byte offset of the first damaged chunk.
+        offset: u64,
+        /// What is wrong with it.
+        detail: String,
+        /// Damaged chunks skipped in all.
+        count: usize,
+    },
     /// The caller passed inconsistent data to the writer (e.g. arrays of different lengths).
     #[error("invalid input: {detail}")]
     InvalidInput {
         /// What was wrong.
         detail: String,
     },
+}
+
+/// What a reader says of damage `e` met after `frames` complete frames: where reading
+/// stopped, or for [`RecordError::SkippedChunks`] (which stops nothing) what was read around
+/// the damaged chunks.
+pub fn damage_note(e: &RecordError, frames: u64) -> String {
+    match e {
+        RecordError::SkippedChunks { .. } => format!("{e}: {}", complete_frames_read(frames)),
+        _ => format!(
+            "{e}; reading stopped there: {}",
+            complete_frames_read(frames)
+        ),
+    }
 }
 
 /// "N complete frames read" ("1 complete frame read"): how a damaged file's messages say what

@@ -6,7 +6,7 @@ use crate::input::named_inputs;
 use crate::names::short_name;
 use crate::plugins::record::{
     ChannelInfo, ReadMode, ReaderLimits, RecordError, RecordingMetadata, RecordingReader,
-    trailing_message,
+    stops_reading, trailing_message,
 };
 use crate::replay::{ReplayError, replay_with};
 use crate::scene::{Registry, parse_scene};
@@ -69,11 +69,8 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
         // damage before the first frame: the header, metadata and channels read before it
         // are still printed (and the exit code says damaged)
         Some(e) => {
-            let msg = format!(
-                "{e}; reading stopped there: {}",
-                crate::plugins::record::complete_frames_read(frames)
-            );
-            (Some(msg.clone()), Some(msg))
+            let msg = crate::plugins::record::damage_note(&e, frames);
+            (stops_reading(&e).then(|| msg.clone()), Some(msg))
         }
         None => (
             reader.truncated().map(str::to_string),

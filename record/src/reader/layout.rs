@@ -129,6 +129,10 @@ pub(crate) struct Layout {
     pub trailing: Option<(u64, u64)>,
     /// Whether the layout comes from the summary section (else from a linear scan).
     pub indexed: bool,
+    /// Chunks left out because their bytes are damaged (CRC, compression, record framing),
+    /// in file order: the scan, and the iterators of an indexed file, go on past them.
+    /// (byte offset, what is wrong) of each.
+    pub skipped: Vec<(u64, String)>,
 }
 
 impl Layout {
@@ -141,6 +145,13 @@ impl Layout {
                 .map(|(id, _)| *id)
                 .collect()
         })
+    }
+
+    /// Records the damaged chunk at `offset` as skipped (once, however often it is met).
+    pub(crate) fn note_skipped(&mut self, offset: u64, detail: String) {
+        if !self.skipped.iter().any(|(at, _)| *at == offset) {
+            self.skipped.push((offset, detail));
+        }
     }
 
     pub(crate) fn schema(&mut self, body: &[u8]) -> Result<(), RecErr> {

@@ -54,7 +54,9 @@ pub struct Recording {
     /// the start of the incomplete record), or a damaged record follows the frames read.
     pub truncated: Option<String>,
     /// `None` unless the file is damaged: a corrupt or undecodable record stopped the reading
-    /// (also given in [`truncated`](Self::truncated)), or bytes follow the closing magic
+    /// (also given in [`truncated`](Self::truncated)), chunks whose bytes are damaged were
+    /// skipped ([`RecordError::SkippedChunks`]: the frames of the other chunks are read, and
+    /// `truncated` stays `None`), or bytes follow the closing magic
     /// ([`trailing_bytes`](Self::trailing_bytes)). Frames before the damage are read.
     pub damaged: Option<String>,
     /// Bytes after the closing magic (0 for an intact or a truncated file).
@@ -70,7 +72,8 @@ pub struct Recording {
 /// gives `Ok` with the frames read and [`Recording::truncated`] set. Data that is not MCAP
 /// gives [`RecordError::NotMcap`]; a damaged record gives [`RecordError::Corrupt`] or
 /// [`RecordError::Decode`] with its byte offset, unless frames were read before it, in which
-/// case they are returned with the error in [`Recording::truncated`]. Never panics.
+/// case they are returned with the error in [`Recording::truncated`]. A chunk whose bytes are
+/// damaged is skipped and the rest read ([`Recording::damaged`]). Never panics.
 pub fn read_recording(path: &Path) -> Result<Recording, RecordError> {
     let reader = RecordingReader::open_with(path, ReadMode::Linear, ReaderLimits::default())?;
     collect(reader)
@@ -120,13 +123,10 @@ pub fn read_last_frame(path: &Path) -> Result<LastFrame, RecordError> {
         }
     }
     match failure {
-        Some(e) if last.frames == 0 => return Err(e),
+        Some(e) if last.frames == 0 && stops_reading(&e) => return Err(e),
         Some(e) => {
-            let msg = format!(
-                "{e}; reading stopped there: {}",
-                crate::complete_frames_read(last.frames)
-            );
-            last.truncated = Some(msg.clone());
+            let msg = crate::damage_note(&e, last.frames);
+            last.truncated = stops_reading(&e).then(|| msg.clone());
             last.damaged = Some(msg);
         }
         None => {
@@ -158,13 +158,11 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
             reader.truncated().map(str::to_string),
             trailing.map(|(at, count)| trailing_message(at, count)),
         ),
-        Some(e) if n == 0 => return Err(e),
+        // nothing read at all: an error (skipped chunks with the metadata read are not)
+        Some(e) if n == 0 && (stops_reading(&e) || reader.metadata().is_none()) => return Err(e),
         Some(e) => {
-            let msg = format!(
-                "{e}; reading stopped there: {}",
-                crate::complete_frames_read(n as u64)
-            );
-            (Some(msg.clone()), Some(msg))
+            let msg = crate::damage_note(&e, n as u64);
+            (stops_reading(&e).then(|| msg.clone()), Some(msg))
         }
     };
     Ok(Recording {
@@ -178,6 +176,12 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
         trailing_bytes: trailing.map_or(0, |t| t.1),
         file_bytes: reader.file_bytes(),
     })
+}
+
+/// Whether damage `e` ended the reading (every error but [`RecordError::SkippedChunks`],
+/// which the reader met after reading everything else).
+pub fn stops_reading(e: &RecordError) -> bool {
+    !matches!(e, RecordError::SkippedChunks { .. })
 }
 
 /// The damage message of `count` bytes after the closing magic, from byte `at`.

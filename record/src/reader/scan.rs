@@ -2,14 +2,20 @@
 //!
 //! A file without summary or footer (a killed process) still yields every complete chunk.
 //! Chunks are taken whole: their records are used only once the chunk has decompressed and
-//! passed its CRC. The data-section and summary CRCs are checked when the file has them. Only
-//! one record is in memory at a time (records that are not needed are streamed through the
-//! CRC), and every length is checked against the bytes left in the file and the reader's
-//! limits before anything is read.
+//! passed its CRC. A chunk whose bytes are damaged but whose record frame (opcode, length) is
+//! sound is skipped ([`Layout::skipped`]) and the scan goes on with the next record, so that
+//! the metadata and the chunks after it are still read; the channels and schemas it may have
+//! defined are then taken from the summary section when the file has a valid one, and the
+//! data-section CRC (which the damaged chunk breaks) is not checked. Otherwise the
+//! data-section and summary CRCs are checked when the file has them. Only one record is in
+//! memory at a time (records that are not needed are streamed through the CRC), and every
+//! length is checked against the bytes left in the file and the reader's limits before
+//! anything is read.
 
 use super::chunk::{ReaderLimits, decompress, split_records};
 use super::layout::{End, Layout, Unit};
 use super::source::Source;
+use super::summary;
 use crate::RecordError;
 use crate::parse::{Cursor, hex_prefix};
 use mcap::records::op;
@@ -22,6 +28,9 @@ enum Stop {
     Truncated(String),
     /// A damaged or undecodable record, or an I/O error.
     Failed(RecordError),
+    /// A chunk whose bytes are damaged, in a sound record frame (its offset, what is wrong):
+    /// skipped.
+    DamagedChunk(u64, String),
 }
 
 fn corrupt(offset: u64, detail: impl Into<String>) -> Stop {
@@ -71,6 +80,9 @@ pub(crate) fn scan<R: Read + Seek>(
         Ok(()) => End::Complete,
         Err(Stop::Truncated(msg)) => End::Truncated(msg),
         Err(Stop::Failed(e)) => End::Failed(e),
+        Err(Stop::DamagedChunk(offset, detail)) => {
+            End::Failed(RecordError::Corrupt { offset, detail })
+        }
     };
     let mut layout = scan.layout;
     layout.end = end;
@@ -215,12 +227,15 @@ impl<R: Read + Seek> Scan<'_, R> {
                 op::CHUNK => {
                     let record = self.read(start, 9 + rlen)?;
                     self.data_crc.update(&record);
-                    self.chunk(start, &record[9..])?;
-                    self.layout.units.push(Unit::Chunk {
-                        offset: start,
-                        len: 9 + rlen,
-                        channels: None,
-                    });
+                    match self.chunk(start, &record[9..]) {
+                        Ok(()) => self.layout.units.push(Unit::Chunk {
+                            offset: start,
+                            len: 9 + rlen,
+                            channels: None,
+                        }),
+                        Err(Stop::DamagedChunk(at, detail)) => self.skip_chunk(at, detail),
+                        Err(stop) => return Err(stop),
+                    }
                 }
                 _ if in_summary => {} // Summary records repeat what the data section holds.
                 op::SCHEMA | op::CHANNEL | op::MESSAGE | op::METADATA => {
@@ -248,7 +263,8 @@ impl<R: Read + Seek> Scan<'_, R> {
                         .u32("data section CRC")
                         .map_err(|e| corrupt(start, format!("data end record: {e}")))?;
                     let computed = self.data_crc.clone().finalize();
-                    if saved != 0 && saved != computed {
+                    // a skipped chunk accounts for a mismatch
+                    if saved != 0 && saved != computed && self.layout.skipped.is_empty() {
                         return Err(corrupt(
                             start,
                             format!(
@@ -363,12 +379,30 @@ impl<R: Read + Seek> Scan<'_, R> {
         Ok(())
     }
 
+    /// Leaves out the damaged chunk at `offset`; at the first, takes the schemas and channels
+    /// that the scan has not met yet from the summary section (they may be defined in the
+    /// chunk).
+    fn skip_chunk(&mut self, offset: u64, detail: String) {
+        if self.layout.skipped.is_empty()
+            && let Some(summary) = summary::indexed(self.src, self.limits)
+        {
+            for (id, schema) in summary.schemas {
+                self.layout.schemas.entry(id).or_insert(schema);
+            }
+            for (id, mut channel) in summary.channels {
+                channel.message_count = 0; // counted by the scan
+                self.layout.channels.entry(id).or_insert(channel);
+            }
+        }
+        self.layout.note_skipped(offset, detail);
+    }
+
     /// Decompresses the chunk at byte `start` (record body `body`) and uses its records once
     /// the whole chunk has decompressed and passed its CRC.
     fn chunk(&mut self, start: u64, body: &[u8]) -> Result<(), Stop> {
-        let data =
-            decompress(body, self.limits).map_err(|e| corrupt(start, format!("chunk: {e}")))?;
-        let records = split_records(&data).map_err(|e| corrupt(start, format!("chunk: {e}")))?;
+        let damaged = |e: String| Stop::DamagedChunk(start, format!("chunk: {e}"));
+        let data = decompress(body, self.limits).map_err(damaged)?;
+        let records = split_records(&data).map_err(damaged)?;
         let state_before = self.layout.state_messages;
         for (k, (opcode, range)) in records.into_iter().enumerate() {
             let body = &data[range];

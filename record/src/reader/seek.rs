@@ -6,7 +6,7 @@
 //! Memory stays bounded whatever the file's size: one count per unit read so far, and the
 //! `/state` messages of the last unit read.
 
-use super::stream::{RawMessage, RecordingReader, duplicate};
+use super::stream::{RawMessage, RecordingReader};
 use crate::proto::ParticleStateWire;
 use crate::reader::layout::Unit;
 use crate::{ParticleFrame, RecordError, STATE_TOPIC};
@@ -91,7 +91,8 @@ impl<R: Read + Seek> RecordingReader<R> {
     /// to the one that holds it (each unit is read once to count its frames; the last one read
     /// is kept, so reading frames in order reads each unit once). `Ok(None)` past the last
     /// complete frame of an intact or truncated file; the damage error past the last readable
-    /// frame of a damaged one.
+    /// frame of a damaged one. Chunks whose bytes are damaged are skipped (their frames are not
+    /// numbered), as by [`frames`](Self::frames).
     ///
     /// # Errors
     /// A damaged or unreadable record before the frame, or an undecodable frame.
@@ -101,10 +102,7 @@ impl<R: Read + Seek> RecordingReader<R> {
         let found = self.find_unit(&mut idx, index);
         let result = found.and_then(|found| {
             let Some(unit) = found else {
-                return match self.damage() {
-                    Some(e) => Err(duplicate(e)),
-                    None => Ok(None),
-                };
+                return self.damage().map_or(Ok(None), Err);
             };
             let messages = match idx.cached.take() {
                 Some((k, m)) if k == unit => m,
@@ -144,7 +142,18 @@ impl<R: Read + Seek> RecordingReader<R> {
             let Some(messages) = self.unit_messages(counted, Some(STATE_TOPIC)) else {
                 return Ok(None);
             };
-            let messages = messages?;
+            let messages = match messages {
+                Ok(m) => m,
+                // a chunk whose bytes are damaged holds no frames for us: skipped (the
+                // iterators do the same; `damage` names it)
+                Err(RecordError::Corrupt { offset, detail })
+                    if matches!(self.layout.units.get(counted), Some(Unit::Chunk { .. })) =>
+                {
+                    self.layout.note_skipped(offset, detail);
+                    Vec::new()
+                }
+                Err(e) => return Err(e),
+            };
             let end = idx.starts[counted] + messages.len() as u64;
             idx.starts.push(end);
             idx.cached = Some((counted, messages));

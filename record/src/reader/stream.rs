@@ -238,11 +238,34 @@ impl<R: Read + Seek> RecordingReader<R> {
         }
     }
 
-    /// The damaged record that ends the readable part of the file, if any (with its offset).
-    pub fn damage(&self) -> Option<&RecordError> {
-        match &self.layout.end {
-            End::Failed(e) => Some(e),
-            _ => None,
+    /// The damaged record that ends the readable part of the file, if any (with its offset);
+    /// else, when damaged chunks were skipped ([`RecordError::SkippedChunks`]), the first of
+    /// them and their number. Chunks are skipped by the scan of [`ReadMode::Linear`] (and of
+    /// a file without a usable summary) when opening, and by [`Self::messages`] and
+    /// [`Self::frames`] as they meet them in an indexed file, so that this grows as they run.
+    pub fn damage(&self) -> Option<RecordError> {
+        match (&self.layout.end, self.layout.skipped.first()) {
+            // the chunks skipped before the record that stopped the reading are named too
+            (End::Failed(RecordError::Corrupt { offset, detail }), Some((at, first))) => {
+                Some(RecordError::Corrupt {
+                    offset: *offset,
+                    detail: format!(
+                        "{detail} (before it, {} damaged chunk(s) were skipped, the first at \
+                         byte {at}: {first})",
+                        self.layout.skipped.len()
+                    ),
+                })
+            }
+            (End::Failed(e), _) => Some(duplicate(e)),
+            _ => self
+                .layout
+                .skipped
+                .first()
+                .map(|(offset, detail)| RecordError::SkippedChunks {
+                    offset: *offset,
+                    detail: detail.clone(),
+                    count: self.layout.skipped.len(),
+                }),
         }
     }
 
@@ -264,7 +287,9 @@ impl<R: Read + Seek> RecordingReader<R> {
     }
 
     /// Iterates the messages on `topic` (all topics for `None`) in file order, one chunk in
-    /// memory at a time. Yields an error and stops at a damaged or unreadable record.
+    /// memory at a time. Yields an error and stops at a damaged or unreadable record; a chunk
+    /// whose bytes are damaged is skipped instead, and [`RecordError::SkippedChunks`] is
+    /// yielded after the last message.
     pub fn messages(&mut self, topic: Option<&str>) -> Messages<'_, R> {
         let channels = self.layout.channel_ids(topic);
         Messages {
@@ -277,7 +302,7 @@ impl<R: Read + Seek> RecordingReader<R> {
     }
 
     /// Iterates the `/state` frames, decoded lazily. Yields an error and stops at a damaged
-    /// record or an undecodable frame.
+    /// record or an undecodable frame; damaged chunks are skipped as in [`Self::messages`].
     pub fn frames(&mut self) -> Frames<'_, R> {
         let encoding = self.state_encoding_error();
         Frames {
@@ -442,7 +467,7 @@ impl<R: Read + Seek> Iterator for Messages<'_, R> {
             }
             let Some(unit) = self.reader.layout.units.get(self.next_unit).cloned() else {
                 self.done = true;
-                return self.reader.damage().map(|e| Err(duplicate(e)));
+                return self.reader.damage().map(Err);
             };
             self.next_unit += 1;
             if let (
@@ -460,6 +485,13 @@ impl<R: Read + Seek> Iterator for Messages<'_, R> {
             let accept = move |id: u16| wanted.as_ref().is_none_or(|w| w.contains(&id));
             match self.reader.load(&unit, &accept) {
                 Ok(messages) => self.pending = messages.into_iter(),
+                // a chunk of an indexed file whose bytes are damaged: the index says where
+                // the next one starts
+                Err(RecordError::Corrupt { offset, detail })
+                    if matches!(unit, Unit::Chunk { .. }) =>
+                {
+                    self.reader.layout.note_skipped(offset, detail);
+                }
                 Err(e) => {
                     self.done = true;
                     return Some(Err(e));

@@ -103,14 +103,123 @@ fn record_rejects_non_mcap_and_corrupt_files() {
     bad[at] ^= 0x40;
     let rec = read_recording_bytes(&bad).unwrap();
     assert_frames_bitwise_eq(&rec.frames, &frames[..2]);
-    let msg = rec.truncated.unwrap();
+    // the chunk is skipped, so reading did not stop: damaged, not truncated
+    assert_eq!(rec.truncated, None);
+    let msg = rec.damaged.unwrap();
     assert!(
         msg.contains(&format!(
             "corrupt recording at byte {}",
             last.chunk_start_offset
-        )),
+        )) && msg.contains("skipped")
+            && msg.contains("2 complete frames read"),
         "{msg}"
     );
+    assert_eq!(rec.metadata, Some(metadata()));
+}
+
+/// A chunk whose bytes are damaged is skipped: the metadata and every frame of the other
+/// chunks are read, by the linear scan and by an indexed reader, and the damage names the
+/// first damaged chunk and how many were skipped.
+#[test]
+fn record_damaged_chunks_are_skipped_and_the_rest_read() {
+    let frames = random_frames(17, 12, true);
+    let (_, bytes) = write_recording("skipped.mcap", &frames, true);
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let chunks: Vec<(u64, u64)> = summary
+        .chunk_indexes
+        .iter()
+        .map(|c| (c.chunk_start_offset, c.chunk_length))
+        .collect();
+    assert!(chunks.len() >= 4, "{chunks:?}");
+    // the frames of each chunk, from the intact file
+    let mut intact = RecordingReader::from_reader(
+        std::io::Cursor::new(bytes.clone()),
+        std::path::Path::new("intact"),
+        ReadMode::Indexed,
+        ReaderLimits::default(),
+    )
+    .unwrap();
+    let per_unit: Vec<usize> = (0..intact.unit_count())
+        .map(|u| {
+            intact
+                .unit_messages(u, Some(STATE_TOPIC))
+                .unwrap()
+                .unwrap()
+                .len()
+        })
+        .collect();
+    assert_eq!(per_unit.iter().sum::<usize>(), frames.len());
+    // damage the first chunk (it holds the schemas and channels) and a middle one
+    let damaged = [0, chunks.len() / 2];
+    let mut bad = bytes.clone();
+    for &k in &damaged {
+        let (start, len) = chunks[k];
+        bad[(start + len / 2) as usize] ^= 0x5a;
+    }
+    let mut expected = Vec::new();
+    let mut next = 0;
+    for (u, n) in per_unit.iter().enumerate() {
+        if !damaged.contains(&u) {
+            expected.extend_from_slice(&frames[next..next + n]);
+        }
+        next += n;
+    }
+    assert!(expected.len() < frames.len());
+    let missing = frames.len() - expected.len();
+    // linear scan
+    let rec = read_recording_bytes(&bad).unwrap();
+    assert_frames_bitwise_eq(&rec.frames, &expected);
+    assert_eq!(rec.metadata, Some(metadata()));
+    assert_eq!(rec.summary_json.as_deref(), Some(super::SUMMARY));
+    assert_eq!(rec.truncated, None);
+    let msg = rec.damaged.clone().unwrap();
+    assert!(
+        msg.contains(&format!("corrupt recording at byte {}", chunks[0].0))
+            && msg.contains("2 damaged chunk(s) skipped")
+            && msg.contains(&format!("{} complete frames read", expected.len())),
+        "{msg} ({missing} frames missing)"
+    );
+    // indexed: the same frames, then the damage
+    let bad_copy = bad.clone();
+    let mut reader = RecordingReader::from_reader(
+        std::io::Cursor::new(bad),
+        std::path::Path::new("bad"),
+        ReadMode::Indexed,
+        ReaderLimits::default(),
+    )
+    .unwrap();
+    assert!(reader.is_indexed());
+    assert_eq!(reader.metadata(), Some(&metadata()));
+    let read: Vec<Result<ParticleFrame, RecordError>> = reader.frames().collect();
+    let (last, ok) = read.split_last().unwrap();
+    let ok: Vec<ParticleFrame> = ok.iter().map(|f| f.as_ref().unwrap().clone()).collect();
+    assert_frames_bitwise_eq(&ok, &expected);
+    match last {
+        Err(RecordError::SkippedChunks { offset, count, .. }) => {
+            assert_eq!((*offset, *count), (chunks[0].0, 2));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        reader.damage(),
+        Some(RecordError::SkippedChunks { count: 2, .. })
+    ));
+    // random access numbers the frames read, as the iterator does
+    let mut reader = RecordingReader::from_reader(
+        std::io::Cursor::new(bad_copy),
+        std::path::Path::new("bad"),
+        ReadMode::Indexed,
+        ReaderLimits::default(),
+    )
+    .unwrap();
+    let by_index: Vec<ParticleFrame> = (0..expected.len() as u64)
+        .map(|i| reader.frame(i).unwrap().unwrap())
+        .collect();
+    assert_frames_bitwise_eq(&by_index, &expected);
+    assert!(matches!(
+        reader.frame(expected.len() as u64),
+        Err(RecordError::SkippedChunks { count: 2, .. })
+    ));
 }
 
 #[test]
@@ -138,7 +247,7 @@ fn record_fuzzed_files_never_panic() {
                 }
                 failed += 1;
             }
-            Ok(Ok(rec)) if rec.truncated.is_some() => {
+            Ok(Ok(rec)) if rec.truncated.is_some() || rec.damaged.is_some() => {
                 // Chunk contents are under CRCs: frames read are original frames, in order.
                 let mut rest = original.frames.iter();
                 for f in &rec.frames {
@@ -148,7 +257,7 @@ fn record_fuzzed_files_never_panic() {
                     );
                 }
                 if std::env::var_os("MAGSEP_SHOW_FUZZ").is_some() {
-                    eprintln!("{i}: {}", rec.truncated.unwrap());
+                    eprintln!("{i}: {:?} {:?}", rec.truncated, rec.damaged);
                 }
                 flagged += 1;
             }

@@ -129,7 +129,7 @@ pub(crate) fn metadata() -> RecordingMetadata {
     }
 }
 
-const SUMMARY: &str = r#"{"steps": 1000, "accepted": 0.5}"#;
+pub(crate) const SUMMARY: &str = r#"{"steps": 1000, "accepted": 0.5}"#;
 
 /// Writes a finished recording of `frames` to a temp file and returns its bytes.
 pub(crate) fn write_recording(
