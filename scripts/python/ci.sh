@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Python package (python/, PyO3 + maturin; not a member of the Cargo workspace): rustfmt
+# The Python package (python/, PyO3 + maturin; a workspace member, not a default one): rustfmt
 # and clippy of its crate, then a fresh venv, the package built into it by
 # `pip install ./python` (maturin, sharing target/ with the workspace's release build), and its
 # pytest suite, which compares it with the `magsep` CLI (built here if missing).

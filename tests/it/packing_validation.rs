@@ -48,7 +48,7 @@ fn spheres_small_reach_a_dense_random_packing() {
 
 // The thesis-size packings take minutes each: they form the full tier, ignored tests named
 // `full_tier_*` that the release tier of CI skips (`--skip full_tier_`) to stay inside its time
-// budget; run them with `cargo test --release --workspace -- --ignored full_tier_`. The fast
+// budget; run them with `cargo test --release -- --ignored full_tier_`. The fast
 // versions above run in the default tier.
 
 #[test]
