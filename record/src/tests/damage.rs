@@ -131,14 +131,17 @@ fn record_damaged_chunks_are_skipped_and_the_rest_read() {
         .map(|c| (c.chunk_start_offset, c.chunk_length))
         .collect();
     assert!(chunks.len() >= 4, "{chunks:?}");
+    let indexed = |b: Vec<u8>| {
+        RecordingReader::from_reader(
+            std::io::Cursor::new(b),
+            std::path::Path::new("skipped.mcap"),
+            ReadMode::Indexed,
+            ReaderLimits::default(),
+        )
+        .unwrap()
+    };
     // the frames of each chunk, from the intact file
-    let mut intact = RecordingReader::from_reader(
-        std::io::Cursor::new(bytes.clone()),
-        std::path::Path::new("intact"),
-        ReadMode::Indexed,
-        ReaderLimits::default(),
-    )
-    .unwrap();
+    let mut intact = indexed(bytes.clone());
     let per_unit: Vec<usize> = (0..intact.unit_count())
         .map(|u| {
             intact
@@ -180,14 +183,7 @@ fn record_damaged_chunks_are_skipped_and_the_rest_read() {
         "{msg} ({missing} frames missing)"
     );
     // indexed: the same frames, then the damage
-    let bad_copy = bad.clone();
-    let mut reader = RecordingReader::from_reader(
-        std::io::Cursor::new(bad),
-        std::path::Path::new("bad"),
-        ReadMode::Indexed,
-        ReaderLimits::default(),
-    )
-    .unwrap();
+    let mut reader = indexed(bad.clone());
     assert!(reader.is_indexed());
     assert_eq!(reader.metadata(), Some(&metadata()));
     let read: Vec<Result<ParticleFrame, RecordError>> = reader.frames().collect();
@@ -205,13 +201,7 @@ fn record_damaged_chunks_are_skipped_and_the_rest_read() {
         Some(RecordError::SkippedChunks { count: 2, .. })
     ));
     // random access numbers the frames read, as the iterator does
-    let mut reader = RecordingReader::from_reader(
-        std::io::Cursor::new(bad_copy),
-        std::path::Path::new("bad"),
-        ReadMode::Indexed,
-        ReaderLimits::default(),
-    )
-    .unwrap();
+    let mut reader = indexed(bad);
     let by_index: Vec<ParticleFrame> = (0..expected.len() as u64)
         .map(|i| reader.frame(i).unwrap().unwrap())
         .collect();
