@@ -101,7 +101,7 @@ pub use frame::{
 pub use reader::{
     ChannelInfo, Frames, LastFrame, MAX_CHUNK_BYTES, Messages, MetadataRecord, RATIO_FREE_BYTES,
     RawMessage, ReadMode, ReaderLimits, Recording, RecordingReader, SchemaInfo, open_regular,
-    read_last_frame, read_recording, read_recording_bytes, stops_reading, trailing_message,
+    read_last_frame, read_recording, read_recording_bytes, trailing_message,
 };
 pub use schema::{ProtoField, ProtoLabel, ProtoType, ProtobufSchema, protobuf_schema};
 pub use writer::{ChannelHandle, FrameBuffering, RecordingSink, RecordingWriter, log_time_ns};
@@ -186,16 +186,17 @@ pub enum RecordError {
     },
 }
 
-/// What a reader says of damage `e` met after `frames` complete frames: where reading
-/// stopped, or for [`RecordError::SkippedChunks`] (which stops nothing) what was read around
-/// the damaged chunks.
-pub fn damage_note(e: &RecordError, frames: u64) -> String {
+/// The `(truncated, damaged)` messages of a reader that met damage `e` after `frames`
+/// complete frames: where reading stopped (in both), or for [`RecordError::SkippedChunks`],
+/// which stops nothing, what was read around the damaged chunks (`damaged` only).
+pub fn damage_messages(e: &RecordError, frames: u64) -> (Option<String>, Option<String>) {
+    let read = complete_frames_read(frames);
     match e {
-        RecordError::SkippedChunks { .. } => format!("{e}: {}", complete_frames_read(frames)),
-        _ => format!(
-            "{e}; reading stopped there: {}",
-            complete_frames_read(frames)
-        ),
+        RecordError::SkippedChunks { .. } => (None, Some(format!("{e}: {read}"))),
+        _ => {
+            let msg = format!("{e}; reading stopped there: {read}");
+            (Some(msg.clone()), Some(msg))
+        }
     }
 }
 

@@ -6,7 +6,7 @@ use crate::input::named_inputs;
 use crate::names::short_name;
 use crate::plugins::record::{
     ChannelInfo, ReadMode, ReaderLimits, RecordError, RecordingMetadata, RecordingReader,
-    stops_reading, trailing_message,
+    trailing_message,
 };
 use crate::replay::{ReplayError, replay_with};
 use crate::scene::{Registry, parse_scene};
@@ -68,10 +68,7 @@ fn scan(path: &Path) -> Result<Scan, CliError> {
     let (truncated, damaged) = match failure {
         // damage before the first frame: the header, metadata and channels read before it
         // are still printed (and the exit code says damaged)
-        Some(e) => {
-            let msg = crate::plugins::record::damage_note(&e, frames);
-            (stops_reading(&e).then(|| msg.clone()), Some(msg))
-        }
+        Some(e) => crate::plugins::record::damage_messages(&e, frames),
         None => (
             reader.truncated().map(str::to_string),
             trailing.map(|(at, n)| trailing_message(at, n)),

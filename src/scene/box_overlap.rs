@@ -13,8 +13,9 @@
 //! grid of 64 angles and located by bisection, and the integral is split there. Both
 //! integrals are adaptive 5-point Gauss–Legendre (tolerances 1e-11 of the disc's area inside,
 //! 1e-9 of the first cylinder's volume outside; at most 2·10⁴ bisections each, and at most
-//! 10⁵ groups per box: a bound on the cost whatever the input). Checked against Steinmetz's two- and three-cylinder solids (16r³/3 and
-//! 8(2 − √2)r³) and against a midpoint grid for a clipped, oblique pair (tests).
+//! 10⁵ groups per box: a bound on the cost whatever the input). Checked against Steinmetz's
+//! two- and three-cylinder solids (16r³/3 and 8(2 − √2)r³) and against a midpoint grid for a
+//! clipped, oblique pair (tests).
 //!
 //! Hand-written: no crate gives the volume of a boolean of finite cylinders and a box to a
 //! known accuracy; a mesh boolean would be a polygonal approximation.
@@ -108,7 +109,7 @@ pub(crate) fn shared_volume_in_box(cs: &[Cylinder], lo: DVec3, hi: DVec3) -> f64
     let mut stack: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
     while let Some(group) = stack.pop() {
         let last = group[group.len() - 1];
-        for (j, cj) in cs.iter().enumerate().skip(last + 1) {
+        for (j, _) in cs.iter().enumerate().skip(last + 1) {
             if budget == 0 {
                 return total;
             }
@@ -117,8 +118,7 @@ pub(crate) fn shared_volume_in_box(cs: &[Cylinder], lo: DVec3, hi: DVec3) -> f64
             }
             let mut larger = group.clone();
             larger.push(j);
-            let mut members: Vec<Cylinder> = group.iter().map(|&k| cs[k]).collect();
-            members.push(*cj);
+            let members: Vec<Cylinder> = larger.iter().map(|&k| cs[k]).collect();
             budget -= 1;
             let v = intersection_volume_in_box(&members, lo, hi);
             if v > 0.0 {

@@ -422,8 +422,6 @@ pub(super) mod tests {
         assert!(rel(v, simple) < 1e-10, "{v} against {simple}");
     }
 
-    /// The part of `c` inside the box `LO`..`HI` by the simple rule: 5-point Gauss-Legendre on
-    /// 20 000 equal pieces of the whole length, no breakpoints.
     /// Midpoint-rule volume \[m³\] of the points of the box `lo`..`hi` where `inside` holds,
     /// on a grid of `n`³ cells (each cell's centre inside or not): the tests' reference.
     pub(in crate::scene) fn grid_volume(
@@ -445,6 +443,8 @@ pub(super) mod tests {
         count as f64 * size.element_product()
     }
 
+    /// The part of `c` inside the box `LO`..`HI` by the simple rule: 5-point Gauss-Legendre on
+    /// 20 000 equal pieces of the whole length, no breakpoints.
     fn composite(c: &Cylinder) -> f64 {
         let (u, w) = c.axis.any_orthonormal_pair();
         let area = |t: f64| section_area(c.center + t * c.axis, c.axis, u, w, c.radius, LO, HI);

@@ -124,11 +124,7 @@ pub fn read_last_frame(path: &Path) -> Result<LastFrame, RecordError> {
     }
     match failure {
         Some(e) if last.frames == 0 && stops_reading(&e) => return Err(e),
-        Some(e) => {
-            let msg = crate::damage_note(&e, last.frames);
-            last.truncated = stops_reading(&e).then(|| msg.clone());
-            last.damaged = Some(msg);
-        }
+        Some(e) => (last.truncated, last.damaged) = crate::damage_messages(&e, last.frames),
         None => {
             last.truncated = reader.truncated().map(str::to_string);
             last.damaged = reader
@@ -160,10 +156,7 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
         ),
         // nothing read at all: an error (skipped chunks with the metadata read are not)
         Some(e) if n == 0 && (stops_reading(&e) || reader.metadata().is_none()) => return Err(e),
-        Some(e) => {
-            let msg = crate::damage_note(&e, n as u64);
-            (stops_reading(&e).then(|| msg.clone()), Some(msg))
-        }
+        Some(e) => crate::damage_messages(&e, n as u64),
     };
     Ok(Recording {
         metadata: reader.metadata().cloned(),
@@ -180,7 +173,7 @@ fn collect<R: Read + Seek>(mut reader: RecordingReader<R>) -> Result<Recording, 
 
 /// Whether damage `e` ended the reading (every error but [`RecordError::SkippedChunks`],
 /// which the reader met after reading everything else).
-pub fn stops_reading(e: &RecordError) -> bool {
+fn stops_reading(e: &RecordError) -> bool {
     !matches!(e, RecordError::SkippedChunks { .. })
 }
 
