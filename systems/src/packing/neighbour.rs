@@ -269,6 +269,24 @@ impl NeighbourList {
         !self.valid || 2.0 * self.max_moved + self.compressed >= self.skin
     }
 
+    /// The displacement bound particle `i` has accumulated since the last build / D.
+    #[inline]
+    pub fn moved_of(&self, i: usize) -> f64 {
+        self.moved.get(i).copied().unwrap_or(0.0)
+    }
+
+    /// Whether a particle whose displacement bound is `m` / D makes the list need a rebuild
+    /// (the per-particle form of [`Self::needs_rebuild`]).
+    #[inline]
+    pub fn exceeds_skin(&self, m: f64) -> bool {
+        2.0 * m + self.compressed >= self.skin
+    }
+
+    /// Largest centre distance a listed pair had at the last build / D (the list's cut-off).
+    pub fn centre_range(&self) -> f64 {
+        self.centre_range
+    }
+
     /// Force a rebuild at the next [`Self::ensure`].
     pub fn invalidate(&mut self) {
         self.valid = false;

@@ -5,7 +5,10 @@
 //! order, E-000-13; in-place sweeps in random order are the convention of D-000-19). One "attempt" is
 //! one single-particle move (the thesis's try: ~200 N per compression step, [T000 §3.2]). The run
 //! succeeds when no overlap above the tolerance remains, and fails when the attempt budget is
-//! spent first.
+//! spent first. In a box that holds four cells of the neighbour list's reach along a periodic
+//! axis, the shuffled particles are visited cell by cell in a checkerboard order instead
+//! ([`super::sweep::cells`]: still random, in-place and serial in effect, and it runs on
+//! several threads); the budget is then tested before each colour's run of cells.
 //!
 //! The scans and sweeps run on the current rayon pool with results independent of the thread
 //! count ([`super::sweep`]); [`overlap_scan`] is the serial full scan they are tested against.
@@ -17,7 +20,10 @@ use rand::seq::SliceRandom;
 use super::moves::{MoveContact, MoveRule};
 use super::neighbour::NeighbourList;
 use super::state::{Body, BodyKind, PackingState};
-use super::sweep::{OverlapTracker, batch_for_threads, commit, contacts_of, propose, sweep};
+use super::sweep::cells::{SweepCells, sweep_cells};
+use super::sweep::{
+    OverlapTracker, batch_for_threads, commit, contacts_of, propose, sweep, uses_rng,
+};
 
 /// Result of [`remove_overlaps`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -191,18 +197,36 @@ pub fn remove_overlaps_batched(
             return outcome(false, attempts);
         }
         order.shuffle(rng);
-        let swept = sweep(
-            state,
-            list,
-            &mut tracker,
-            &order,
-            rule,
-            tol,
-            budget,
-            &mut attempts,
-            batch,
-            rng,
-        );
+        let cells = if uses_rng(rule) {
+            None
+        } else {
+            SweepCells::choose(state, list, rng)
+        };
+        let swept = match cells {
+            Some(cells) => sweep_cells(
+                state,
+                list,
+                &mut tracker,
+                &order,
+                &cells,
+                rule,
+                tol,
+                budget,
+                &mut attempts,
+            ),
+            None => sweep(
+                state,
+                list,
+                &mut tracker,
+                &order,
+                rule,
+                tol,
+                budget,
+                &mut attempts,
+                batch,
+                rng,
+            ),
+        };
         sweeps += 1;
         if swept.moves == 0 {
             // every overlapping particle is stuck (no positive-rate contact): spend the budget

@@ -144,19 +144,27 @@ impl PackingState {
         shift: DVec3,
         warm: &mut Option<WarmStart>,
     ) -> PairContact {
+        let (xi, qi) = (self.positions[i], self.orientations[i]);
+        let (xj, qj) = (self.positions[j] + shift, self.orientations[j]);
+        self.contact_warm_at(i, (xi, qi), j, (xj, qj), warm)
+    }
+
+    /// [`Self::contact_warm`] with the poses (centre, orientation) of `i` and of `j` given (j's
+    /// centre with its image shift), as a sweep sees them before its moves are written back.
+    #[inline]
+    pub fn contact_warm_at(
+        &self,
+        i: usize,
+        (xi, qi): (DVec3, DQuat),
+        j: usize,
+        (xj, qj): (DVec3, DQuat),
+        warm: &mut Option<WarmStart>,
+    ) -> PairContact {
         let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
         if let (BodyKind::Rod, BodyKind::Rod) = (bi.kind, bj.kind) {
-            return self.contact(i, j, shift);
+            return body_contact(bi, xi, qi, bj, xj, qj);
         }
-        superquadric_contact(
-            bi,
-            self.positions[i],
-            self.orientations[i],
-            bj,
-            self.positions[j] + shift,
-            self.orientations[j],
-            warm,
-        )
+        superquadric_contact(bi, xi, qi, bj, xj, qj, warm)
     }
 
     /// [`Self::contact_warm`] if the pair overlaps by more than `tol`, else None. A
@@ -173,22 +181,38 @@ impl PackingState {
         warm: &mut Option<WarmStart>,
         tol: f64,
     ) -> Option<PairContact> {
+        let (xi, qi) = (self.positions[i], self.orientations[i]);
+        let (xj, qj) = (self.positions[j] + shift, self.orientations[j]);
+        self.contact_warm_above_at(i, (xi, qi), j, (xj, qj), warm, tol)
+    }
+
+    /// [`Self::contact_warm_above`] with the poses given (see [`Self::contact_warm_at`]).
+    #[inline]
+    pub fn contact_warm_above_at(
+        &self,
+        i: usize,
+        pose_i: (DVec3, DQuat),
+        j: usize,
+        pose_j: (DVec3, DQuat),
+        warm: &mut Option<WarmStart>,
+        tol: f64,
+    ) -> Option<PairContact> {
         let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
         if self.is_superquadric_pair(i, j) {
             let bound = overlap_upper_bound(
                 &bi.contact_shape,
-                self.positions[i],
-                self.orientations[i],
+                pose_i.0,
+                pose_i.1,
                 &bj.contact_shape,
-                self.positions[j] + shift,
-                self.orientations[j],
+                pose_j.0,
+                pose_j.1,
                 warm.as_ref(),
             );
             if bound <= tol - BOUND_MARGIN {
                 return None;
             }
         }
-        let c = self.contact_warm(i, j, shift, warm);
+        let c = self.contact_warm_at(i, pose_i, j, pose_j, warm);
         (c.overlap > tol).then_some(c)
     }
 

@@ -39,7 +39,15 @@
 //! is therefore bit for bit the move of the serial sweep, for any B and any thread count. Only
 //! the rules without random numbers (revised, original) run in batches; the random-direction
 //! variants of fig. 3.4 use the serial loop.
+//!
+//! **Sweep by cells** ([`cells`]). When the box holds four cells of the list's reach along a
+//! periodic axis, the rules without random numbers sweep in a checkerboard order instead: the
+//! cells of one colour share no listed pair, so they run at once, each serially, without
+//! stale proposals and with one join per colour instead of one per batch. It is a different
+//! serial order from the plain shuffled one (the packings differ, statistically the same), and
+//! again the same on any thread count.
 
+use glam::{DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -70,7 +78,11 @@ pub struct OverlapTracker {
     /// Particles moved since the last scan, and their marks.
     moved: Vec<u32>,
     moved_mark: Vec<bool>,
-    /// Scratch: pair marks and selected pairs.
+    /// Per particle: listed pairs whose overlap is above the tolerance.
+    above: Vec<u32>,
+    /// The tolerance of the last scan.
+    tol: f64,
+    /// Scratch: pair marks (all false between scans) and selected pairs.
     pair_mark: Vec<bool>,
     selected: Vec<u32>,
     /// Moves of each particle since the last full scan (the contact cache's clock).
@@ -158,12 +170,19 @@ impl OverlapTracker {
     ) -> ScanCount {
         let n = state.len();
         let npairs = list.unique().len();
-        let full =
-            self.built != Some(list.builds) || self.overlap.len() != npairs || self.wall.len() != n;
+        let full = self.built != Some(list.builds)
+            || self.overlap.len() != npairs
+            || self.wall.len() != n
+            || self.tol.to_bits() != tol.to_bits();
         self.selected.clear();
         if full {
+            self.tol = tol;
             self.overlap.clear();
             self.overlap.resize(npairs, f64::NEG_INFINITY);
+            self.above.clear();
+            self.above.resize(n, 0);
+            self.pair_mark.clear();
+            self.pair_mark.resize(npairs, false);
             self.wall.clear();
             self.wall.resize(n, false);
             self.version.clear();
@@ -172,21 +191,21 @@ impl OverlapTracker {
             self.cache.resize(list.len(), None);
             self.selected.extend(0..npairs as u32);
         } else {
-            self.pair_mark.clear();
-            self.pair_mark.resize(npairs, false);
+            // the pairs of the moved particles, each once (marks cleared again below)
             for &i in &self.moved {
                 let first = list.entry_start(i as usize);
                 for k in first..first + list.of(i as usize).len() {
-                    self.pair_mark[list.pair_of_entry(k)] = true;
+                    let p = list.pair_of_entry(k);
+                    if !self.pair_mark[p] {
+                        self.pair_mark[p] = true;
+                        self.selected.push(p as u32);
+                    }
                 }
             }
-            self.selected.extend(
-                self.pair_mark
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, m)| **m)
-                    .map(|(p, _)| p as u32),
-            );
+            for &p in &self.selected {
+                self.pair_mark[p as usize] = false;
+            }
+            self.selected.sort_unstable();
         }
         let count = self.evaluate_pairs(state, list, tol);
         // walls: every particle on a full scan, the moved ones otherwise
@@ -204,13 +223,7 @@ impl OverlapTracker {
                 .for_each(|&i| wall_of(i as usize, &mut self.wall));
         }
         flags.clear();
-        flags.extend_from_slice(&self.wall);
-        for (p, o) in list.unique().iter().zip(&self.overlap) {
-            if *o > tol {
-                flags[p.i as usize] = true;
-                flags[p.j as usize] = true;
-            }
-        }
+        flags.extend(self.wall.iter().zip(&self.above).map(|(w, a)| *w || *a > 0));
         for &i in &self.moved {
             self.moved_mark[i as usize] = false;
         }
@@ -250,6 +263,17 @@ impl OverlapTracker {
             let (i, j, k) = (e.i as usize, e.j as usize, e.k as usize);
             count.contacts += 1;
             let sq = state.is_superquadric_pair(i, j);
+            let new = c.as_ref().map_or(f64::NEG_INFINITY, |c| c.overlap);
+            let (was, is) = (self.overlap[p as usize] > tol, new > tol);
+            if was != is {
+                for e in [i, j] {
+                    self.above[e] = if is {
+                        self.above[e] + 1
+                    } else {
+                        self.above[e].saturating_sub(1)
+                    };
+                }
+            }
             let Some(c) = c else {
                 // at most the tolerance, not solved: the Newton starts stay as they are
                 self.overlap[p as usize] = f64::NEG_INFINITY;
@@ -326,20 +350,46 @@ pub fn contacts_of(
     out: &mut Vec<MoveContact>,
     warm: &mut Vec<Option<WarmStart>>,
 ) {
+    contacts_with(state, list, tracker, i, tol, out, warm, |_| None);
+}
+
+/// [`contacts_of`] where `moved(j)` gives the pose (centre, orientation) of a neighbour `j`
+/// that has moved since the state was written (a cell sweep's moves before their write-back),
+/// None for the state's own pose. A moved neighbour's pair is solved anew (not taken from the
+/// tracker's cache).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn contacts_with(
+    state: &PackingState,
+    list: &NeighbourList,
+    tracker: Option<&OverlapTracker>,
+    i: usize,
+    tol: f64,
+    out: &mut Vec<MoveContact>,
+    warm: &mut Vec<Option<WarmStart>>,
+    moved: impl Fn(usize) -> Option<(DVec3, DQuat)>,
+) {
     out.clear();
     warm.clear();
     let first = list.entry_start(i);
+    let pose_i = (state.positions[i], state.orientations[i]);
     for k in first..first + list.of(i).len() {
         let nb = list.entry(k);
+        let j = nb.j as usize;
         let mut w = list.warm(k);
-        if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, nb.j as usize)) {
-            warm.push(w);
-            if let Some(c) = c.filter(|c| c.overlap > tol) {
-                out.push(c);
+        let c = if let Some((xj, qj)) = moved(j) {
+            let pose_j = (xj + nb.shift(state.edges), qj);
+            state.contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
+        } else {
+            if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, j)) {
+                warm.push(w);
+                if let Some(c) = c.filter(|c| c.overlap > tol) {
+                    out.push(c);
+                }
+                continue;
             }
-            continue;
-        }
-        let c = state.contact_warm_above(i, nb.j as usize, nb.shift(state.edges), &mut w, tol);
+            state.contact_warm_above(i, j, nb.shift(state.edges), &mut w, tol)
+        };
         warm.push(w);
         if let Some(c) = c {
             out.push(MoveContact::from(&c));
@@ -509,6 +559,8 @@ pub fn batch_for_threads() -> usize {
     let t = rayon::current_num_threads();
     if t <= 1 { 1 } else { BATCH_PER_THREAD * t }
 }
+
+pub mod cells;
 
 #[cfg(test)]
 mod tests;

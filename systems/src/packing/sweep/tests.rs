@@ -18,7 +18,12 @@ const SUPERBALL: Shape = Shape::Superquadric {
 
 /// `n` bodies of `shape` inserted at phi min(`phi`, 0.3) and compressed to `phi` (overlapping
 /// above 0.3).
-fn overlapping(shape: Shape, n: usize, phi: f64, seed: u64) -> (PackingState, NeighbourList) {
+pub(super) fn overlapping(
+    shape: Shape,
+    n: usize,
+    phi: f64,
+    seed: u64,
+) -> (PackingState, NeighbourList) {
     let bodies: Vec<Body> = (0..n).map(|_| Body::from_shape(&shape, 1.0)).collect();
     let v: f64 = bodies.iter().map(|b| b.volume).sum();
     let mut rngs: Vec<_> = (0..n as u64).map(|i| particle_stream(seed, i)).collect();
@@ -38,14 +43,14 @@ fn overlapping(shape: Shape, n: usize, phi: f64, seed: u64) -> (PackingState, Ne
     (state, list)
 }
 
-fn pool(threads: usize) -> rayon::ThreadPool {
+pub(super) fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap()
 }
 
-fn bits(s: &PackingState) -> Vec<u64> {
+pub(super) fn bits(s: &PackingState) -> Vec<u64> {
     let mut v = vec![s.edges.x.to_bits()];
     for (x, q) in s.positions.iter().zip(&s.orientations) {
         v.extend(x.to_array().map(f64::to_bits));
