@@ -359,7 +359,7 @@ pub fn contacts_of(
 /// tracker's cache).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub(crate) fn contacts_with(
+pub fn contacts_with(
     state: &PackingState,
     list: &NeighbourList,
     tracker: Option<&OverlapTracker>,
@@ -436,6 +436,26 @@ pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &
     true
 }
 
+/// [`commit`] and count it: a move that happened is an attempt, a move of the sweep and a
+/// version step of particle `i` in the tracker. Returns whether it moved.
+pub(crate) fn commit_counted(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    tracker: &mut OverlapTracker,
+    i: usize,
+    p: &Proposal,
+    attempts: &mut u64,
+    count: &mut SweepCount,
+) -> bool {
+    let moved = commit(state, list, i, p);
+    if moved {
+        *attempts += 1;
+        count.moves += 1;
+        tracker.note_moved(i);
+    }
+    moved
+}
+
 /// Whether `rule` draws random numbers (then sweeps are serial).
 pub fn uses_rng(rule: MoveRule) -> bool {
     matches!(
@@ -480,11 +500,7 @@ pub fn sweep(
                 list.build(state);
             }
             let p = propose(state, list, Some(tracker), i, rule, tol, &mut scratch, rng);
-            if commit(state, list, i, &p) {
-                *attempts += 1;
-                count.moves += 1;
-                tracker.note_moved(i);
-            }
+            commit_counted(state, list, tracker, i, &p, attempts, &mut count);
         }
         return count;
     }
@@ -520,9 +536,9 @@ pub fn sweep(
                 continue 'batches;
             }
             let stale = list.of(i).iter().any(|nb| stamp[nb.j as usize] == round);
-            let moved = if stale {
+            let p = if stale {
                 count.recomputed += 1;
-                let fresh = propose(
+                &propose(
                     state,
                     list,
                     Some(tracker),
@@ -531,16 +547,12 @@ pub fn sweep(
                     tol,
                     &mut scratch,
                     &mut no_rng,
-                );
-                commit(state, list, i, &fresh)
+                )
             } else {
-                commit(state, list, i, p)
+                p
             };
-            if moved {
+            if commit_counted(state, list, tracker, i, p, attempts, &mut count) {
                 stamp[i] = round;
-                *attempts += 1;
-                count.moves += 1;
-                tracker.note_moved(i);
             }
         }
         pos = end;

@@ -31,7 +31,7 @@ use glam::{DQuat, DVec3};
 use rand::{Rng, RngExt};
 use rayon::prelude::*;
 
-use super::{OverlapTracker, Proposal, SweepCount, commit, contacts_with, unused_rng};
+use super::{OverlapTracker, Proposal, SweepCount, commit_counted, contacts_with, unused_rng};
 use crate::packing::moves::{MoveRule, overlap_removal_move};
 use crate::packing::neighbour::NeighbourList;
 use crate::packing::removal::turn_bound;
@@ -216,11 +216,7 @@ pub fn sweep_cells(
                 let mut stopped = false;
                 for (&c, r) in g.iter().zip(results) {
                     for (i, p) in &r.moves {
-                        if commit(state, list, *i, p) {
-                            *attempts += 1;
-                            count.moves += 1;
-                            tracker.note_moved(*i);
-                        }
+                        commit_counted(state, list, tracker, *i, p, attempts, &mut count);
                     }
                     stopped |= r.end < queues[c].len();
                     pos[c] = r.end;

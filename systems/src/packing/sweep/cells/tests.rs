@@ -5,7 +5,7 @@ use rand::seq::SliceRandom;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::super::tests::{bits, overlapping, pool};
-use super::super::{OverlapTracker, commit, propose};
+use super::super::{OverlapTracker, commit_counted, propose};
 use super::*;
 use crate::packing::removal::remove_overlaps;
 
@@ -35,8 +35,8 @@ fn reference_sweep(
     tol: f64,
     budget: u64,
     attempts: &mut u64,
-) -> u64 {
-    let mut moves = 0;
+) -> SweepCount {
+    let mut count = SweepCount::default();
     let mut scratch = Vec::new();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(0);
     for queues in cells.queues(state, order) {
@@ -49,7 +49,7 @@ fn reference_sweep(
                 break;
             }
             if *attempts >= budget {
-                return moves;
+                return count;
             }
             if list.needs_rebuild() {
                 list.build(state);
@@ -88,14 +88,11 @@ fn reference_sweep(
                             &mut scratch,
                             &mut rng,
                         );
-                        if commit(state, list, i, &p) {
-                            *attempts += 1;
-                            moves += 1;
-                            tracker.note_moved(i);
-                            if list.exceeds_skin(list.moved_of(i)) {
-                                stopped = true;
-                                break;
-                            }
+                        let moved =
+                            commit_counted(state, list, tracker, i, &p, attempts, &mut count);
+                        if moved && list.exceeds_skin(list.moved_of(i)) {
+                            stopped = true;
+                            break;
                         }
                     }
                 }
@@ -105,7 +102,7 @@ fn reference_sweep(
             }
         }
     }
-    moves
+    count
 }
 
 /// One scan and one sweep from an overlapping state, by [`sweep_cells`] on `threads` threads
@@ -135,36 +132,26 @@ fn one_sweep(
         let cells = cells_of(&state, &list);
         let before = list.builds;
         let (s, l, t) = (&mut state, &mut list, &mut tracker);
-        moves += match threads {
-            Some(th) => {
-                pool(th)
-                    .install(|| {
-                        sweep_cells(
-                            s,
-                            l,
-                            t,
-                            &order,
-                            &cells,
-                            REVISED,
-                            1e-4,
-                            budget,
-                            &mut attempts,
-                        )
-                    })
-                    .moves
-            }
-            None => reference_sweep(
-                s,
-                l,
-                t,
-                &order,
-                &cells,
-                REVISED,
-                1e-4,
-                budget,
-                &mut attempts,
-            ),
+        let f = if threads.is_some() {
+            sweep_cells
+        } else {
+            reference_sweep
         };
+        moves += pool(threads.unwrap_or(1))
+            .install(|| {
+                f(
+                    s,
+                    l,
+                    t,
+                    &order,
+                    &cells,
+                    REVISED,
+                    1e-4,
+                    budget,
+                    &mut attempts,
+                )
+            })
+            .moves;
         builds += list.builds - before;
     }
     (bits(&state), moves, builds)
