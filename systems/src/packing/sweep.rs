@@ -56,7 +56,7 @@ use super::contact::PairContact;
 use super::moves::{Displacement, MoveContact, MoveRule, overlap_removal_move};
 use super::neighbour::NeighbourList;
 use super::removal::turn_bound;
-use super::state::PackingState;
+use super::state::{Body, PackingState};
 use crate::geometry::superquadric::WarmStart;
 
 /// Pairs per rayon task of the pair scan (a sphere pair costs ~20 ns, a superball pair ~1 us).
@@ -334,6 +334,17 @@ impl OverlapTracker {
 pub struct Proposal {
     warm: Vec<Option<WarmStart>>,
     displacement: Option<Displacement>,
+    /// How far the rotation moves a surface point ([`turn_bound`]), computed with the move so
+    /// that the serial write-back does not.
+    turn: f64,
+}
+
+impl Proposal {
+    /// Set the displacement of a particle of `body` and its turn bound.
+    fn set_displacement(&mut self, body: &Body, d: Option<Displacement>) {
+        self.displacement = d;
+        self.turn = d.map_or(0.0, |d| turn_bound(body, d.rotation));
+    }
 }
 
 /// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls
@@ -414,8 +425,11 @@ pub fn propose(
 ) -> Proposal {
     let mut p = Proposal::default();
     contacts_of(state, list, tracker, i, tol, scratch, &mut p.warm);
-    p.displacement =
-        overlap_removal_move(rule, &state.bodies[i], state.orientations[i], scratch, rng);
+    let body = &state.bodies[i];
+    p.set_displacement(
+        body,
+        overlap_removal_move(rule, body, state.orientations[i], scratch, rng),
+    );
     p
 }
 
@@ -429,10 +443,9 @@ pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &
     let Some(d) = p.displacement else {
         return false;
     };
-    let turn = turn_bound(&state.bodies[i], d.rotation);
     state.positions[i] += d.dx;
     state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
-    list.note_move(i, d.dx, turn);
+    list.note_move(i, d.dx, p.turn);
     true
 }
 

@@ -34,7 +34,6 @@ use rayon::prelude::*;
 use super::{OverlapTracker, Proposal, SweepCount, commit_counted, contacts_with, unused_rng};
 use crate::packing::moves::{MoveRule, overlap_removal_move};
 use crate::packing::neighbour::NeighbourList;
-use crate::packing::removal::turn_bound;
 use crate::packing::state::PackingState;
 
 /// Axes are split until a colour has at least this many cells (more, smaller tasks balance
@@ -309,11 +308,14 @@ fn run_cell(
             moved,
         );
         let (x, o) = (state.positions[i], state.orientations[i]);
-        p.displacement = overlap_removal_move(rule, &state.bodies[i], o, &scratch, &mut no_rng);
+        let body = &state.bodies[i];
+        p.set_displacement(
+            body,
+            overlap_removal_move(rule, body, o, &scratch, &mut no_rng),
+        );
         let past_skin = p.displacement.is_some_and(|d| {
             poses[q - start] = Some((x + d.dx, (d.rotation * o).normalize()));
-            let turn = turn_bound(&state.bodies[i], d.rotation);
-            list.exceeds_skin(list.moved_of(i) + (d.dx.length() + turn))
+            list.exceeds_skin(list.moved_of(i) + (d.dx.length() + p.turn))
         });
         moves.push((i, p));
         if past_skin {
