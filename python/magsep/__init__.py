@@ -337,7 +337,8 @@ class Recording:
 
     @property
     def damaged(self) -> Optional[str]:
-        """None unless a damaged record ends the readable part or bytes follow the footer."""
+        """None unless a damaged record ends the readable part, damaged chunks were skipped
+        (known once the reading has reached them) or bytes follow the footer."""
         return self._r.damaged
 
     @property
@@ -389,7 +390,9 @@ class Recording:
 
     def messages(self, topic: Optional[str] = None) -> Iterator[Message]:
         """The messages on ``topic`` (every channel for None) in file order, as raw bytes with
-        their schema names: a plugin's channel is decoded with its schema (:meth:`schema`)."""
+        their schema names: a plugin's channel is decoded with its schema (:meth:`schema`).
+        A chunk whose bytes are damaged is skipped and the rest read; the damage is then
+        raised (:class:`RecordingError`) after the last message, as by iterating the frames."""
         unit = 0
         while True:
             batch = self._r.unit_messages(unit, topic)

@@ -111,6 +111,32 @@ def test_a_truncated_recording_opens_and_reports_truncation(packing, tmp_path, f
         assert_frame_equal(frame, ref)
 
 
+def test_a_damaged_chunk_is_skipped_and_the_rest_read():
+    """A bit flip inside one chunk of the corpus's recording: frames and messages skip that
+    chunk, read every other one (equal to the intact file's frames bit for bit), and the
+    damage is raised only after the last of them."""
+    corpus = ROOT / "tests/data/bad_recordings"
+    intact = {f.step: f for f in magsep.open_recording(corpus / "base.mcap")}
+    rec = magsep.open_recording(corpus / "flip_chunk_data.mcap")
+    frames, messages = [], []
+    with pytest.raises(magsep.RecordingError, match="skipped"):
+        for f in rec:
+            frames.append(f)
+    with pytest.raises(magsep.RecordingError, match="skipped"):
+        for m in rec.messages("/state"):
+            messages.append(m)
+    assert len(frames) == len(messages) == 4 < len(intact)
+    for f in frames:
+        ref = intact[f.step]
+        for name in ["time", "ids", "positions", "orientations", "radii", "half_lengths"]:
+            got, want = getattr(f, name), getattr(ref, name)
+            if isinstance(want, np.ndarray) and want.dtype == np.float64:
+                assert np.array_equal(bits(got), bits(want)), name
+            else:
+                assert np.array_equal(got, want), name
+    assert "corrupt recording at byte 6265" in rec.damaged
+
+
 def test_bad_files_raise_value_errors(tmp_path):
     text = tmp_path / "x.mcap"
     text.write_text("not a recording")

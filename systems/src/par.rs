@@ -67,3 +67,5 @@ pub fn in_rayon_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
         rayon::scope(|_| f())
     }
 }
+
+pub mod team;

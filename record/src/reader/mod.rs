@@ -11,6 +11,8 @@ mod summary;
 
 pub use chunk::{MAX_CHUNK_BYTES, RATIO_FREE_BYTES, ReaderLimits};
 pub use layout::MetadataRecord;
+#[cfg(test)]
+pub(crate) use seek::decode_frame;
 pub use stream::{
     Frames, Messages, RawMessage, ReadMode, RecordingReader, SchemaInfo, open_regular,
 };

@@ -65,6 +65,8 @@ impl<R: Read + Seek> RecordingReader<R> {
     /// file order; `None` past the last unit. Reading unit after unit gives what
     /// [`messages`](Self::messages) yields, without borrowing the reader between calls; after
     /// the last unit, [`damage`](Self::damage) tells whether a damaged record ended the file.
+    /// A chunk whose bytes are damaged gives no messages (`Ok` and empty), as the iterators
+    /// skip it; [`damage`](Self::damage) names it ([`RecordError::SkippedChunks`]).
     pub fn unit_messages(
         &mut self,
         unit: usize,
@@ -84,7 +86,15 @@ impl<R: Read + Seek> RecordingReader<R> {
             return Some(Ok(Vec::new()));
         }
         let accept = move |id: u16| wanted.as_ref().is_none_or(|w| w.contains(&id));
-        Some(self.load(&u, &accept))
+        Some(match self.load(&u, &accept) {
+            // a chunk whose bytes are damaged: skipped, as by the iterators (the index says
+            // where the next unit starts)
+            Err(RecordError::Corrupt { offset, detail }) if matches!(u, Unit::Chunk { .. }) => {
+                self.layout.note_skipped(offset, detail);
+                Ok(Vec::new())
+            }
+            other => other,
+        })
     }
 
     /// The `/state` frame number `index` (0 is the first) decoded, reading only the units up
@@ -142,18 +152,8 @@ impl<R: Read + Seek> RecordingReader<R> {
             let Some(messages) = self.unit_messages(counted, Some(STATE_TOPIC)) else {
                 return Ok(None);
             };
-            let messages = match messages {
-                Ok(m) => m,
-                // a chunk whose bytes are damaged holds no frames for us: skipped (the
-                // iterators do the same; `damage` names it)
-                Err(RecordError::Corrupt { offset, detail })
-                    if matches!(self.layout.units.get(counted), Some(Unit::Chunk { .. })) =>
-                {
-                    self.layout.note_skipped(offset, detail);
-                    Vec::new()
-                }
-                Err(e) => return Err(e),
-            };
+            // a chunk whose bytes are damaged gives no frames (skipped by `unit_messages`)
+            let messages = messages?;
             let end = idx.starts[counted] + messages.len() as u64;
             idx.starts.push(end);
             idx.cached = Some((counted, messages));

@@ -201,6 +201,7 @@ fn record_damaged_chunks_are_skipped_and_the_rest_read() {
         Some(RecordError::SkippedChunks { count: 2, .. })
     ));
     // random access numbers the frames read, as the iterator does
+    let bytes_damaged = bad.clone();
     let mut reader = indexed(bad);
     let by_index: Vec<ParticleFrame> = (0..expected.len() as u64)
         .map(|i| reader.frame(i).unwrap().unwrap())
@@ -209,6 +210,24 @@ fn record_damaged_chunks_are_skipped_and_the_rest_read() {
     assert!(matches!(
         reader.frame(expected.len() as u64),
         Err(RecordError::SkippedChunks { count: 2, .. })
+    ));
+    // unit by unit (the Python `messages`): the damaged chunks give nothing, the others
+    // their messages, then the damage
+    let mut reader = indexed(bytes_damaged);
+    let mut by_unit = Vec::new();
+    for u in 0..reader.unit_count() {
+        let m = reader.unit_messages(u, Some(STATE_TOPIC)).unwrap().unwrap();
+        assert_eq!(m.is_empty(), damaged.contains(&u), "unit {u}");
+        by_unit.extend(
+            m.iter()
+                .map(|m| crate::reader::decode_frame(m, 0, None).unwrap()),
+        );
+    }
+    assert!(reader.unit_messages(reader.unit_count(), None).is_none());
+    assert_frames_bitwise_eq(&by_unit, &expected);
+    assert!(matches!(
+        reader.damage(),
+        Some(RecordError::SkippedChunks { count: 2, .. })
     ));
 }
 

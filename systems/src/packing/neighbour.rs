@@ -266,7 +266,7 @@ impl NeighbourList {
     /// Whether the list must be rebuilt before use.
     #[inline]
     pub fn needs_rebuild(&self) -> bool {
-        !self.valid || 2.0 * self.max_moved + self.compressed >= self.skin
+        !self.valid || self.exceeds_skin(self.max_moved)
     }
 
     /// The displacement bound particle `i` has accumulated since the last build / D.
@@ -493,6 +493,12 @@ impl NeighbourList {
     #[inline]
     pub fn warm(&self, k: usize) -> Option<WarmStart> {
         self.warm[k]
+    }
+
+    /// The unordered pairs and the twin of every entry (read) beside the cached contact
+    /// solutions (written), borrowed at once.
+    pub(crate) fn pairs_and_warm(&mut self) -> (&[PairEntry], &[u32], &mut [Option<WarmStart>]) {
+        (&self.pairs, &self.twin, &mut self.warm)
     }
 
     /// The cached contact solution of entry `k`.

@@ -24,6 +24,7 @@ use super::sweep::cells::{SweepCells, sweep_cells};
 use super::sweep::{
     OverlapTracker, batch_for_threads, commit, contacts_of, propose, sweep, uses_rng,
 };
+use crate::par::team::Team;
 
 /// Result of [`remove_overlaps`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,9 +52,8 @@ pub fn overlapping_contacts(
 ) {
     let mut warm = Vec::new();
     contacts_of(state, list, None, i, tol, out, &mut warm);
-    let first = list.entry_start(i);
-    for (k, w) in warm.into_iter().enumerate() {
-        *list.warm_mut(first + k) = w;
+    for (k, w) in warm {
+        *list.warm_mut(k as usize) = w;
     }
 }
 
@@ -154,7 +154,9 @@ pub fn remove_overlaps(
     remove_overlaps_batched(state, list, rule, tol, budget, batch_for_threads(), rng)
 }
 
-/// [`remove_overlaps`] with `batch` moves proposed at a time (1: the serial sweep).
+/// [`remove_overlaps`] with `batch` moves proposed at a time in the plain shuffled order (1:
+/// the serial sweep); a sweep by cells ([`super::sweep::cells`]) has its own order and
+/// ignores `batch`. The parallel phases run on a [`Team`] of the current rayon pool's size.
 pub fn remove_overlaps_batched(
     state: &mut PackingState,
     list: &mut NeighbourList,
@@ -164,6 +166,21 @@ pub fn remove_overlaps_batched(
     batch: usize,
     rng: &mut impl Rng,
 ) -> RemovalOutcome {
+    Team::scope(|team| remove_overlaps_on(state, list, rule, tol, budget, batch, rng, team))
+}
+
+/// [`remove_overlaps_batched`] on `team`.
+#[allow(clippy::too_many_arguments)]
+fn remove_overlaps_on(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    rule: MoveRule,
+    tol: f64,
+    budget: u64,
+    batch: usize,
+    rng: &mut impl Rng,
+    team: &Team<'_>,
+) -> RemovalOutcome {
     let mut attempts = 0;
     let mut sweeps = 0;
     let mut flags = Vec::new();
@@ -172,7 +189,7 @@ pub fn remove_overlaps_batched(
     let (mut contacts, mut fallbacks) = (0, 0);
     loop {
         list.ensure(state);
-        let scan = tracker.scan(state, list, tol, &mut flags);
+        let scan = tracker.scan(state, list, tol, &mut flags, team);
         contacts += scan.contacts;
         fallbacks += scan.fallbacks;
         order.clear();
@@ -213,6 +230,7 @@ pub fn remove_overlaps_batched(
                 tol,
                 budget,
                 &mut attempts,
+                team,
             ),
             None => sweep(
                 state,
@@ -225,6 +243,7 @@ pub fn remove_overlaps_batched(
                 &mut attempts,
                 batch,
                 rng,
+                team,
             ),
         };
         sweeps += 1;

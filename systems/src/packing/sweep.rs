@@ -50,289 +50,23 @@
 use glam::{DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use rayon::prelude::*;
 
-use super::contact::PairContact;
 use super::moves::{Displacement, MoveContact, MoveRule, overlap_removal_move};
 use super::neighbour::NeighbourList;
 use super::removal::turn_bound;
 use super::state::{Body, PackingState};
 use crate::geometry::superquadric::WarmStart;
-
-/// Pairs per rayon task of the pair scan (a sphere pair costs ~20 ns, a superball pair ~1 us).
-const SCAN_CHUNK: usize = 64;
+use crate::par::team::Team;
 
 /// Moves proposed per batch and thread of the parallel sweep.
 pub const BATCH_PER_THREAD: usize = 4;
 
-/// The overlaps of the list's pairs between scans of one overlap removal (see the module
-/// header).
-#[derive(Debug, Clone, Default)]
-pub struct OverlapTracker {
-    /// Overlap / D per pair of [`NeighbourList::unique`].
-    overlap: Vec<f64>,
-    /// Per particle: a wall overlap above the tolerance.
-    wall: Vec<bool>,
-    /// `NeighbourList::builds` at the last scan (None: no scan yet).
-    built: Option<u64>,
-    /// Particles moved since the last scan, and their marks.
-    moved: Vec<u32>,
-    moved_mark: Vec<bool>,
-    /// Per particle: listed pairs whose overlap is above the tolerance.
-    above: Vec<u32>,
-    /// The tolerance of the last scan.
-    tol: f64,
-    /// Scratch: pair marks (all false between scans) and selected pairs.
-    pair_mark: Vec<bool>,
-    selected: Vec<u32>,
-    /// Moves of each particle since the last full scan (the contact cache's clock).
-    version: Vec<u32>,
-    /// Per directed list entry: the superquadric pair contact of the last scan, with the
-    /// versions of both ends it was computed at (see [`Self::cached`]).
-    cache: Vec<Option<CachedContact>>,
-}
-
-/// A scanned pair contact and the move versions of its two ends at the time.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct CachedContact {
-    version_i: u32,
-    version_j: u32,
-    /// None: the overlap is certainly at most the tolerance (not solved).
-    contact: Option<MoveContact>,
-}
-
-/// Contacts evaluated by one scan.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct ScanCount {
-    /// Pair contacts evaluated.
-    pub contacts: u64,
-    /// Of which the contact solver fell back to its estimate.
-    pub fallbacks: u64,
-}
-
-impl OverlapTracker {
-    /// A tracker whose next scan is full.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Record that particle `i` moved.
-    pub fn note_moved(&mut self, i: usize) {
-        if self.moved_mark.len() <= i {
-            self.moved_mark.resize(i + 1, false);
-        }
-        if self.version.len() <= i {
-            self.version.resize(i + 1, 0);
-        }
-        self.version[i] = self.version[i].wrapping_add(1);
-        if !self.moved_mark[i] {
-            self.moved_mark[i] = true;
-            self.moved.push(i as u32);
-        }
-    }
-
-    /// Force a full scan next time.
-    pub fn invalidate(&mut self) {
-        self.built = None;
-    }
-
-    /// The contact of list entry `k` (particle `i` with its neighbour `j`) as the last scan
-    /// computed it (inner None: at most the tolerance, not solved), if it is still the
-    /// contact of the present poses: a superquadric pair
-    /// whose ends have not moved since, in the list the scan saw. Within one overlap removal
-    /// only [`sweep`]'s commits move particles, and every moving commit is noted
-    /// ([`Self::note_moved`]).
-    #[inline]
-    pub fn cached(
-        &self,
-        list: &NeighbourList,
-        k: usize,
-        i: usize,
-        j: usize,
-    ) -> Option<Option<MoveContact>> {
-        if self.built != Some(list.builds) {
-            return None;
-        }
-        let c = self.cache.get(k).copied().flatten()?;
-        let v = |p: usize| self.version.get(p).copied().unwrap_or(0);
-        (c.version_i == v(i) && c.version_j == v(j)).then_some(c.contact)
-    }
-
-    /// Set `flags[i]` for every particle with a pair or wall overlap above `tol`, evaluating
-    /// the pairs with a moved end (all pairs on the first scan or after a rebuild). The list
-    /// must be valid (`NeighbourList::ensure`).
-    pub fn scan(
-        &mut self,
-        state: &PackingState,
-        list: &mut NeighbourList,
-        tol: f64,
-        flags: &mut Vec<bool>,
-    ) -> ScanCount {
-        let n = state.len();
-        let npairs = list.unique().len();
-        let full = self.built != Some(list.builds)
-            || self.overlap.len() != npairs
-            || self.wall.len() != n
-            || self.tol.to_bits() != tol.to_bits();
-        self.selected.clear();
-        if full {
-            self.tol = tol;
-            self.overlap.clear();
-            self.overlap.resize(npairs, f64::NEG_INFINITY);
-            self.above.clear();
-            self.above.resize(n, 0);
-            self.pair_mark.clear();
-            self.pair_mark.resize(npairs, false);
-            self.wall.clear();
-            self.wall.resize(n, false);
-            self.version.clear();
-            self.version.resize(n, 0);
-            self.cache.clear();
-            self.cache.resize(list.len(), None);
-            self.selected.extend(0..npairs as u32);
-        } else {
-            // the pairs of the moved particles, each once (marks cleared again below)
-            for &i in &self.moved {
-                let first = list.entry_start(i as usize);
-                for k in first..first + list.of(i as usize).len() {
-                    let p = list.pair_of_entry(k);
-                    if !self.pair_mark[p] {
-                        self.pair_mark[p] = true;
-                        self.selected.push(p as u32);
-                    }
-                }
-            }
-            for &p in &self.selected {
-                self.pair_mark[p as usize] = false;
-            }
-            self.selected.sort_unstable();
-        }
-        let count = self.evaluate_pairs(state, list, tol);
-        // walls: every particle on a full scan, the moved ones otherwise
-        let mut walls = Vec::new();
-        let mut wall_of = |i: usize, wall: &mut Vec<bool>| {
-            walls.clear();
-            state.wall_contacts(i, 0.0, &mut walls);
-            wall[i] = walls.iter().any(|c| c.overlap > tol);
-        };
-        if full {
-            (0..n).for_each(|i| wall_of(i, &mut self.wall));
-        } else {
-            self.moved
-                .iter()
-                .for_each(|&i| wall_of(i as usize, &mut self.wall));
-        }
-        flags.clear();
-        flags.extend(self.wall.iter().zip(&self.above).map(|(w, a)| *w || *a > 0));
-        for &i in &self.moved {
-            self.moved_mark[i as usize] = false;
-        }
-        self.moved.clear();
-        self.built = Some(list.builds);
-        count
-    }
-}
-
-impl OverlapTracker {
-    /// Evaluate the pairs `selected` (indices into [`NeighbourList::unique`]) in parallel and
-    /// store, in `selected` order, their overlaps, their Newton starts in the list (in both
-    /// directions for superquadric pairs) and their superquadric contacts in the cache (both
-    /// directions, at the present move versions).
-    fn evaluate_pairs(
-        &mut self,
-        state: &PackingState,
-        list: &mut NeighbourList,
-        tol: f64,
-    ) -> ScanCount {
-        let l = &*list;
-        let results: Vec<(Option<PairContact>, Option<WarmStart>)> = self
-            .selected
-            .par_iter()
-            .with_min_len(SCAN_CHUNK)
-            .map(|&p| {
-                let e = l.unique()[p as usize];
-                let mut warm = l.warm(e.k as usize);
-                let (i, j, shift) = (e.i as usize, e.j as usize, e.shift(state.edges));
-                let c = state.contact_warm_above(i, j, shift, &mut warm, tol);
-                (c, warm)
-            })
-            .collect();
-        let mut count = ScanCount::default();
-        for (&p, (c, warm)) in self.selected.iter().zip(results) {
-            let e = list.unique()[p as usize];
-            let (i, j, k) = (e.i as usize, e.j as usize, e.k as usize);
-            count.contacts += 1;
-            let sq = state.is_superquadric_pair(i, j);
-            let new = c.as_ref().map_or(f64::NEG_INFINITY, |c| c.overlap);
-            let (was, is) = (self.overlap[p as usize] > tol, new > tol);
-            if was != is {
-                for e in [i, j] {
-                    self.above[e] = if is {
-                        self.above[e] + 1
-                    } else {
-                        self.above[e].saturating_sub(1)
-                    };
-                }
-            }
-            let Some(c) = c else {
-                // at most the tolerance, not solved: the Newton starts stay as they are
-                self.overlap[p as usize] = f64::NEG_INFINITY;
-                if sq {
-                    let twin = list.twin(k);
-                    let (vi, vj) = (self.version[i], self.version[j]);
-                    self.cache[k] = Some(CachedContact {
-                        version_i: vi,
-                        version_j: vj,
-                        contact: None,
-                    });
-                    self.cache[twin] = Some(CachedContact {
-                        version_i: vj,
-                        version_j: vi,
-                        contact: None,
-                    });
-                }
-                continue;
-            };
-            *list.warm_mut(k) = warm;
-            self.overlap[p as usize] = c.overlap;
-            count.fallbacks += c.fallback as u64;
-            if sq {
-                // the other direction: the same contact seen from j (a valid starting point
-                // and contact for j's next move; superquadric contacts are warm-started
-                // Newton solutions, not bit-reproducible anyway)
-                let twin = list.twin(k);
-                *list.warm_mut(twin) = warm.map(|w| WarmStart {
-                    s_a: w.s_b,
-                    s_b: w.s_a,
-                });
-                let (vi, vj) = (self.version[i], self.version[j]);
-                self.cache[k] = Some(CachedContact {
-                    version_i: vi,
-                    version_j: vj,
-                    contact: Some(MoveContact::from(&c)),
-                });
-                self.cache[twin] = Some(CachedContact {
-                    version_i: vj,
-                    version_j: vi,
-                    contact: Some(MoveContact {
-                        overlap: c.overlap,
-                        normal: -c.normal,
-                        k: -c.k,
-                        s: c.t,
-                        rc: c.rc_j,
-                    }),
-                });
-            }
-        }
-        count
-    }
-}
-
-/// The move of one particle computed from a fixed state: its new Newton starts (one per list
-/// entry of the particle, in entry order) and its displacement.
+/// The move of one particle computed from a fixed state: the Newton starts it changed and its
+/// displacement.
 #[derive(Debug, Clone, Default)]
 pub struct Proposal {
-    warm: Vec<Option<WarmStart>>,
+    /// The Newton starts the move changed: (list entry, start).
+    warm: Vec<(u32, Option<WarmStart>)>,
     displacement: Option<Displacement>,
     /// How far the rotation moves a surface point ([`turn_bound`]), computed with the move so
     /// that the serial write-back does not.
@@ -348,8 +82,8 @@ impl Proposal {
 }
 
 /// Overlapping contacts (overlap > `tol`) of particle `i` with its neighbours and the walls
-/// into `out`, reading the cached Newton starts and writing the updated ones into `warm` (one
-/// per entry of i), without changing the list. With a `tracker`, superquadric pairs whose
+/// into `out`, reading the cached Newton starts and writing the ones that changed into `warm`
+/// (list entry, new start), without changing the list. With a `tracker`, superquadric pairs whose
 /// ends have not moved since its last scan take the scanned contact instead of a new solve
 /// ([`OverlapTracker::cached`]).
 pub fn contacts_of(
@@ -359,9 +93,20 @@ pub fn contacts_of(
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
-    warm: &mut Vec<Option<WarmStart>>,
+    warm: &mut Vec<(u32, Option<WarmStart>)>,
 ) {
     contacts_with(state, list, tracker, i, tol, out, warm, |_| None);
+}
+
+/// Whether two Newton starts are the same bit for bit (so that storing one over the other
+/// changes nothing, signed zeros included).
+fn same_bits(a: &Option<WarmStart>, b: &Option<WarmStart>) -> bool {
+    let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => bits(a.s_a) == bits(b.s_a) && bits(a.s_b) == bits(b.s_b),
+        _ => false,
+    }
 }
 
 /// [`contacts_of`] where `moved(j)` gives the pose (centre, orientation) of a neighbour `j`
@@ -377,7 +122,7 @@ pub fn contacts_with(
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
-    warm: &mut Vec<Option<WarmStart>>,
+    warm: &mut Vec<(u32, Option<WarmStart>)>,
     moved: impl Fn(usize) -> Option<(DVec3, DQuat)>,
 ) {
     out.clear();
@@ -387,13 +132,13 @@ pub fn contacts_with(
     for k in first..first + list.of(i).len() {
         let nb = list.entry(k);
         let j = nb.j as usize;
-        let mut w = list.warm(k);
+        let old = list.warm(k);
+        let mut w = old;
         let c = if let Some((xj, qj)) = moved(j) {
             let pose_j = (xj + nb.shift(state.edges), qj);
             state.contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
         } else {
             if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, j)) {
-                warm.push(w);
                 if let Some(c) = c.filter(|c| c.overlap > tol) {
                     out.push(c);
                 }
@@ -401,7 +146,9 @@ pub fn contacts_with(
             }
             state.contact_warm_above(i, j, nb.shift(state.edges), &mut w, tol)
         };
-        warm.push(w);
+        if !same_bits(&w, &old) {
+            warm.push((k as u32, w));
+        }
         if let Some(c) = c {
             out.push(MoveContact::from(&c));
         }
@@ -436,9 +183,8 @@ pub fn propose(
 /// Apply the proposal of particle `i`: store its Newton starts and move it. Returns whether it
 /// moved.
 pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &Proposal) -> bool {
-    let first = list.entry_start(i);
-    for (k, w) in p.warm.iter().enumerate() {
-        *list.warm_mut(first + k) = *w;
+    for &(k, w) in &p.warm {
+        *list.warm_mut(k as usize) = w;
     }
     let Some(d) = p.displacement else {
         return false;
@@ -501,6 +247,7 @@ pub fn sweep(
     attempts: &mut u64,
     batch: usize,
     rng: &mut impl Rng,
+    team: &Team<'_>,
 ) -> SweepCount {
     let mut count = SweepCount::default();
     let mut scratch = Vec::new();
@@ -529,14 +276,19 @@ pub fn sweep(
         let end = (pos + batch).min(order.len());
         let ids = &order[pos..end];
         let (s, l, t) = (&*state, &*list, &*tracker);
-        let proposals: Vec<Proposal> = ids
-            .par_iter()
-            .with_max_len(1)
-            .map(|&i| {
-                let mut scratch = Vec::new();
-                propose(s, l, Some(t), i, rule, tol, &mut scratch, &mut unused_rng())
-            })
-            .collect();
+        let proposals: Vec<Proposal> = team.map(ids.len(), |m| {
+            let mut scratch = Vec::new();
+            propose(
+                s,
+                l,
+                Some(t),
+                ids[m],
+                rule,
+                tol,
+                &mut scratch,
+                &mut unused_rng(),
+            )
+        });
         round += 1;
         for (m, (&i, p)) in ids.iter().zip(&proposals).enumerate() {
             if *attempts >= budget {
@@ -586,6 +338,9 @@ pub fn batch_for_threads() -> usize {
 }
 
 pub mod cells;
+mod tracker;
+
+pub use tracker::{OverlapTracker, ScanCount};
 
 #[cfg(test)]
 mod tests;

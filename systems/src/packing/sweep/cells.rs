@@ -11,8 +11,13 @@
 //! listed pair was within the cut-off at the build and each end has moved by less than half
 //! the skin since): the moves in one cell read no pose that a move in another cell of its
 //! colour writes, and the cells of a colour can run at once, each serially, with the result
-//! of the serial order. This is checked on the list itself before each run; if a listed pair
-//! does join two such cells, the colour's cells run one after the other instead.
+//! of the serial order. The particles still to move have not moved since they were put in
+//! their cells (one move per particle and sweep), so two of them in different cells of a
+//! colour are at least the narrowest cell's width apart: when that width is at least the
+//! list's present reach (a rebuild within the sweep may lengthen it), no listed pair can join
+//! them. Otherwise it is checked on the list itself before each run; if a listed pair does
+//! join two such cells, the colour's cells run one after the other instead. Within a run the
+//! cells with the most particles left are started first (the results are kept in cell order).
 //!
 //! **Runs.** A cell's moves are computed against the state at the start of the run, with the
 //! poses of the cell's own earlier moves laid over it ([`super::contacts_with`]), and written
@@ -29,12 +34,12 @@
 
 use glam::{DQuat, DVec3};
 use rand::{Rng, RngExt};
-use rayon::prelude::*;
 
 use super::{OverlapTracker, Proposal, SweepCount, commit_counted, contacts_with, unused_rng};
 use crate::packing::moves::{MoveRule, overlap_removal_move};
 use crate::packing::neighbour::NeighbourList;
 use crate::packing::state::PackingState;
+use crate::par::team::Team;
 
 /// Axes are split until a colour has at least this many cells (more, smaller tasks balance
 /// the threads better; fewer colours mean fewer joins per sweep).
@@ -98,6 +103,14 @@ impl SweepCells {
         })
     }
 
+    /// The narrowest cell's width along the cut axes / D (infinite when no axis is cut).
+    pub fn min_width(&self) -> f64 {
+        (0..3)
+            .filter(|&a| self.n[a] > 1)
+            .map(|a| self.edges[a] / self.n[a] as f64)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// The (colour, cell index) of a centre `x`.
     pub fn locate(&self, x: DVec3) -> (u32, u32) {
         let mut colour = 0;
@@ -119,19 +132,22 @@ impl SweepCells {
     /// The sweep's queues: per colour (in order), per cell of it (in index order), the
     /// particles of `order` in that cell, in `order`'s order.
     pub fn queues(&self, state: &PackingState, order: &[usize]) -> Vec<Vec<Vec<usize>>> {
-        let mut keyed: Vec<(u32, u32, usize)> = order
+        // the position in `order` makes every key distinct: an unstable sort keeps `order`'s
+        // order within a cell
+        let mut keyed: Vec<(u32, u32, u32, usize)> = order
             .iter()
-            .map(|&i| {
+            .enumerate()
+            .map(|(q, &i)| {
                 let (colour, cell) = self.locate(state.positions[i]);
-                (colour, cell, i)
+                (colour, cell, q as u32, i)
             })
             .collect();
-        keyed.sort_by_key(|&(colour, cell, _)| (colour, cell));
+        keyed.sort_unstable_by_key(|&(colour, cell, q, _)| (colour, cell, q));
         let mut out: Vec<Vec<Vec<usize>>> = Vec::new();
         let mut colour_cells: Vec<Vec<usize>> = Vec::new();
         let mut queue: Vec<usize> = Vec::new();
         let mut last: Option<(u32, u32)> = None;
-        for (colour, cell, i) in keyed {
+        for (colour, cell, _, i) in keyed {
             if let Some((c, k)) = last {
                 if (c, k) != (colour, cell) {
                     colour_cells.push(std::mem::take(&mut queue));
@@ -180,6 +196,7 @@ pub fn sweep_cells(
     tol: f64,
     budget: u64,
     attempts: &mut u64,
+    team: &Team<'_>,
 ) -> SweepCount {
     let mut count = SweepCount::default();
     let mut marks = Marks {
@@ -202,16 +219,28 @@ pub fn sweep_cells(
                 list.build(state);
             }
             mark(&mut marks, &queues, &live, &pos);
-            let groups = groups(list, &marks, &queues, &live, &pos);
+            let groups = if cells.min_width() >= list.centre_range() + list.skin {
+                // no listed pair can join two cells of a colour (module header)
+                vec![live.clone()]
+            } else {
+                groups(list, &marks, &queues, &live, &pos)
+            };
             for g in groups {
                 let (s, l, t, m) = (&*state, &*list, &*tracker, &marks);
                 let run =
                     |&c: &usize| run_cell(s, l, t, &queues[c], pos[c], c as u32, m, rule, tol);
-                let results: Vec<CellRun> = if g.len() > 1 {
-                    g.par_iter().with_max_len(1).map(run).collect()
-                } else {
-                    g.iter().map(run).collect()
-                };
+                // the longest queues first, so that no thread is left with a long cell at
+                // the end of the phase; the results are kept in cell order
+                let mut longest: Vec<usize> = (0..g.len()).collect();
+                longest.sort_by_key(|&x| std::cmp::Reverse(queues[g[x]].len() - pos[g[x]]));
+                let mut results: Vec<Option<CellRun>> = (0..g.len()).map(|_| None).collect();
+                for (x, r) in longest
+                    .iter()
+                    .zip(team.map(g.len(), |y| run(&g[longest[y]])))
+                {
+                    results[*x] = Some(r);
+                }
+                let results = results.into_iter().flatten();
                 let mut stopped = false;
                 for (&c, r) in g.iter().zip(results) {
                     for (i, p) in &r.moves {

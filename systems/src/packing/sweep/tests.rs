@@ -70,7 +70,8 @@ fn tracked_flags_equal_the_full_serial_scan_after_moves() {
     for round in 0..6 {
         list.ensure(&mut state);
         let builds = list.builds;
-        let count = pool(2).install(|| tracker.scan(&state, &mut list, tol, &mut flags));
+        let count = pool(2)
+            .install(|| Team::scope(|team| tracker.scan(&state, &mut list, tol, &mut flags, team)));
         let mut reference = list.clone();
         overlap_scan(&state, &mut reference, tol, &mut want);
         assert_eq!(flags, want, "round {round}");
@@ -82,18 +83,21 @@ fn tracked_flags_equal_the_full_serial_scan_after_moves() {
         let order: Vec<usize> = (0..state.len()).filter(|i| flags[*i]).take(5).collect();
         let mut attempts = 0;
         let rule = MoveRule::Revised { dt: 0.1 };
-        sweep(
-            &mut state,
-            &mut list,
-            &mut tracker,
-            &order,
-            rule,
-            tol,
-            u64::MAX,
-            &mut attempts,
-            1,
-            &mut rng,
-        );
+        Team::scope(|team| {
+            sweep(
+                &mut state,
+                &mut list,
+                &mut tracker,
+                &order,
+                rule,
+                tol,
+                u64::MAX,
+                &mut attempts,
+                1,
+                &mut rng,
+                team,
+            )
+        });
         assert!(attempts > 0);
     }
     assert!(
@@ -222,7 +226,8 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
     let (mut hits, mut compared_after_moves, mut below) = (0, 0, 0);
     for round in 0..4 {
         list.ensure(&mut state);
-        pool(2).install(|| tracker.scan(&state, &mut list, tol, &mut flags));
+        pool(2)
+            .install(|| Team::scope(|team| tracker.scan(&state, &mut list, tol, &mut flags, team)));
         for i in 0..state.len() {
             let first = list.entry_start(i);
             for k in first..first + list.of(i).len() {
@@ -252,18 +257,21 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
         let builds = list.builds;
         let before = (state.positions.clone(), state.orientations.clone());
         let rule = MoveRule::Revised { dt: 0.1 };
-        sweep(
-            &mut state,
-            &mut list,
-            &mut tracker,
-            &order,
-            rule,
-            tol,
-            u64::MAX,
-            &mut attempts,
-            1,
-            &mut rng,
-        );
+        Team::scope(|team| {
+            sweep(
+                &mut state,
+                &mut list,
+                &mut tracker,
+                &order,
+                rule,
+                tol,
+                u64::MAX,
+                &mut attempts,
+                1,
+                &mut rng,
+                team,
+            )
+        });
         assert!(attempts > 0);
         if list.builds == builds {
             let moved = |i: usize| {

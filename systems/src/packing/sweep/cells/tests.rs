@@ -35,6 +35,7 @@ fn reference_sweep(
     tol: f64,
     budget: u64,
     attempts: &mut u64,
+    _team: &Team<'_>,
 ) -> SweepCount {
     let mut count = SweepCount::default();
     let mut scratch = Vec::new();
@@ -126,7 +127,7 @@ fn one_sweep(
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
     for _ in 0..3 {
         list.ensure(&mut state);
-        tracker.scan(&state, &mut list, 1e-4, &mut flags);
+        Team::scope(|team| tracker.scan(&state, &mut list, 1e-4, &mut flags, team));
         let mut order: Vec<usize> = (0..n).filter(|&i| flags[i]).collect();
         order.shuffle(&mut rng);
         let cells = cells_of(&state, &list);
@@ -139,17 +140,20 @@ fn one_sweep(
         };
         moves += pool(threads.unwrap_or(1))
             .install(|| {
-                f(
-                    s,
-                    l,
-                    t,
-                    &order,
-                    &cells,
-                    REVISED,
-                    1e-4,
-                    budget,
-                    &mut attempts,
-                )
+                Team::scope(|team| {
+                    f(
+                        s,
+                        l,
+                        t,
+                        &order,
+                        &cells,
+                        REVISED,
+                        1e-4,
+                        budget,
+                        &mut attempts,
+                        team,
+                    )
+                })
             })
             .moves;
         builds += list.builds - before;
