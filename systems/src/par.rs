@@ -68,4 +68,15 @@ pub fn in_rayon_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     }
 }
 
+/// Run `f` on a rayon pool of one thread: for work that runs beside other such work (the
+/// replicates of a study, the points of a sweep), so that its parallel phases do not start
+/// helpers ([`team::Team`]) or split across threads the other jobs already occupy. Runs `f`
+/// in place if the pool cannot be built.
+pub fn on_one_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
+        Ok(pool) => pool.install(f),
+        Err(_) => f(),
+    }
+}
+
 pub mod team;

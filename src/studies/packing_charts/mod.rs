@@ -239,7 +239,10 @@ pub fn points(specs: &[PointSpec]) -> Result<Vec<Point>, BenchError> {
         .with_max_len(1)
         .map(|&(k, seed)| {
             let s = &specs[k];
-            measure(sizes[k], s.shape, &s.container, s.phi0, seed, s.scheme)
+            // one thread per run: the runs fill the cores
+            magsep_systems::par::on_one_thread(|| {
+                measure(sizes[k], s.shape, &s.container, s.phi0, seed, s.scheme)
+            })
         })
         .collect::<Result<_, _>>()?;
     let mut runs: Vec<Vec<(u64, RunMeasures)>> = vec![Vec::new(); specs.len()];

@@ -234,7 +234,7 @@ pub fn chart_wedge(out: &Path, quick: bool) -> Result<(), BenchError> {
     let map_ratio = *ratios.last().unwrap_or(&3.0);
     let (computed, map_run) = rayon::join(
         || points(&specs),
-        || orientation_run(n, angles[0] * deg, map_ratio),
+        || magsep_systems::par::on_one_thread(|| orientation_run(n, angles[0] * deg, map_ratio)),
     );
     let mut computed = computed?.into_iter();
     let mut next = || {

@@ -525,7 +525,14 @@ impl Runner<'_> {
                         {
                             break;
                         }
-                        match self.run_point(&base, index) {
+                        // one thread per point: the points fill the cores
+                        let point = || self.run_point(&base, index);
+                        let end = if jobs > 1 {
+                            magsep_systems::par::on_one_thread(point)
+                        } else {
+                            point()
+                        };
+                        match end {
                             Ok(PointEnd::Ok) => {
                                 finished.fetch_add(1, Ordering::Relaxed);
                             }

@@ -19,6 +19,8 @@
 //! Helpers are OS threads of a [`std::thread::scope`] (one fewer than rayon's current
 //! thread count), not rayon jobs, so the leader may still use rayon inside the team's scope
 //! (rayon's idle threads help it as usual) without ever running a helper's wait loop itself.
+//! Work that runs beside other work on the same cores (a study's replicates) should run on a
+//! one-thread pool ([`super::on_one_thread`]): its team then has no helpers.
 
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
@@ -74,7 +76,8 @@ impl Shared {
 
     /// A helper's loop: join every phase published until `stop`.
     fn help(&self) {
-        let mut seen = self.epoch.load(Ordering::Acquire);
+        // 0: a phase published before this helper started is joined too
+        let mut seen = 0;
         let mut idle = Instant::now();
         let mut spins = 0u32;
         while !self.stop.load(Ordering::Acquire) {
@@ -134,7 +137,8 @@ impl Team<'_> {
         }
         std::thread::scope(|s| {
             for _ in 1..threads {
-                s.spawn(|| shared.help());
+                // a helper that cannot be started is only missing: phases never wait for one
+                let _ = std::thread::Builder::new().spawn_scoped(s, || shared.help());
             }
             let out = catch_unwind(AssertUnwindSafe(|| {
                 f(&Team {
@@ -152,7 +156,9 @@ impl Team<'_> {
         self.threads
     }
 
-    /// `f(i)` for `i` in `0..n`, on every thread of the team, in index order.
+    /// `f(i)` for `i` in `0..n`, on every thread of the team, in index order. Only the
+    /// leader (the thread that runs [`Team::scope`]'s closure) calls it, and never from
+    /// inside a task (a team runs one phase at a time).
     pub fn map<R: Send>(&self, n: usize, f: impl Fn(usize) -> R + Sync) -> Vec<R> {
         if self.threads == 1 || n <= 1 {
             return (0..n).map(f).collect();

@@ -81,29 +81,40 @@ fn tracked_flags_equal_the_full_serial_scan_after_moves() {
         }
         // move a few particles, as a sweep would
         let order: Vec<usize> = (0..state.len()).filter(|i| flags[*i]).take(5).collect();
-        let mut attempts = 0;
-        let rule = MoveRule::Revised { dt: 0.1 };
-        Team::scope(|team| {
-            sweep(
-                &mut state,
-                &mut list,
-                &mut tracker,
-                &order,
-                rule,
-                tol,
-                u64::MAX,
-                &mut attempts,
-                1,
-                &mut rng,
-                team,
-            )
-        });
-        assert!(attempts > 0);
+        assert!(serial_sweep(&mut state, &mut list, &mut tracker, &order, &mut rng) > 0);
     }
     assert!(
         partial_scans >= 3,
         "only the moved particles' pairs are re-evaluated"
     );
+}
+
+/// One serial sweep of `order` with the revised rule (tolerance 1e-4, no budget): the moves.
+fn serial_sweep(
+    state: &mut PackingState,
+    list: &mut NeighbourList,
+    tracker: &mut OverlapTracker,
+    order: &[usize],
+    rng: &mut Xoshiro256PlusPlus,
+) -> u64 {
+    let mut attempts = 0;
+    let rule = MoveRule::Revised { dt: 0.1 };
+    Team::scope(|team| {
+        sweep(
+            state,
+            list,
+            tracker,
+            order,
+            rule,
+            1e-4,
+            u64::MAX,
+            &mut attempts,
+            1,
+            rng,
+            team,
+        )
+    });
+    attempts
 }
 
 fn removal_bits(
@@ -253,26 +264,9 @@ fn cached_contacts_equal_fresh_solves_and_moves_invalidate_them() {
             }
         }
         let order: Vec<usize> = (0..state.len()).filter(|i| flags[*i]).take(8).collect();
-        let mut attempts = 0;
         let builds = list.builds;
         let before = (state.positions.clone(), state.orientations.clone());
-        let rule = MoveRule::Revised { dt: 0.1 };
-        Team::scope(|team| {
-            sweep(
-                &mut state,
-                &mut list,
-                &mut tracker,
-                &order,
-                rule,
-                tol,
-                u64::MAX,
-                &mut attempts,
-                1,
-                &mut rng,
-                team,
-            )
-        });
-        assert!(attempts > 0);
+        assert!(serial_sweep(&mut state, &mut list, &mut tracker, &order, &mut rng) > 0);
         if list.builds == builds {
             let moved = |i: usize| {
                 state.positions[i] != before.0[i] || state.orientations[i] != before.1[i]
