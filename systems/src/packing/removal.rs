@@ -166,96 +166,83 @@ pub fn remove_overlaps_batched(
     batch: usize,
     rng: &mut impl Rng,
 ) -> RemovalOutcome {
-    Team::scope(|team| remove_overlaps_on(state, list, rule, tol, budget, batch, rng, team))
-}
-
-/// [`remove_overlaps_batched`] on `team`.
-#[allow(clippy::too_many_arguments)]
-fn remove_overlaps_on(
-    state: &mut PackingState,
-    list: &mut NeighbourList,
-    rule: MoveRule,
-    tol: f64,
-    budget: u64,
-    batch: usize,
-    rng: &mut impl Rng,
-    team: &Team<'_>,
-) -> RemovalOutcome {
-    let mut attempts = 0;
-    let mut sweeps = 0;
-    let mut flags = Vec::new();
-    let mut order = Vec::new();
-    let mut tracker = OverlapTracker::new();
-    let (mut contacts, mut fallbacks) = (0, 0);
-    loop {
-        list.ensure(state);
-        let scan = tracker.scan(state, list, tol, &mut flags, team);
-        contacts += scan.contacts;
-        fallbacks += scan.fallbacks;
-        order.clear();
-        order.extend(
-            flags
-                .iter()
-                .enumerate()
-                .filter(|(_, f)| **f)
-                .map(|(i, _)| i),
-        );
-        let outcome = |success, attempts| RemovalOutcome {
-            success,
-            attempts,
-            sweeps,
-            contacts,
-            fallbacks,
-        };
-        if order.is_empty() {
-            return outcome(true, attempts);
-        }
-        if attempts >= budget {
-            return outcome(false, attempts);
-        }
-        order.shuffle(rng);
-        let cells = if uses_rng(rule) {
-            None
-        } else {
-            SweepCells::choose(state, list, rng)
-        };
-        let swept = match cells {
-            Some(cells) => sweep_cells(
-                state,
-                list,
-                &mut tracker,
-                &order,
-                &cells,
-                rule,
-                tol,
-                budget,
-                &mut attempts,
-                team,
-            ),
-            None => sweep(
-                state,
-                list,
-                &mut tracker,
-                &order,
-                rule,
-                tol,
-                budget,
-                &mut attempts,
-                batch,
-                rng,
-                team,
-            ),
-        };
-        sweeps += 1;
-        if swept.moves == 0 {
-            // every overlapping particle is stuck (no positive-rate contact): spend the budget
-            return RemovalOutcome {
-                success: false,
-                attempts: budget.max(attempts),
+    Team::scope(|team| {
+        let mut attempts = 0;
+        let mut sweeps = 0;
+        let mut flags = Vec::new();
+        let mut order = Vec::new();
+        let mut tracker = OverlapTracker::new();
+        let (mut contacts, mut fallbacks) = (0, 0);
+        loop {
+            list.ensure(state);
+            let scan = tracker.scan(state, list, tol, &mut flags, team);
+            contacts += scan.contacts;
+            fallbacks += scan.fallbacks;
+            order.clear();
+            order.extend(
+                flags
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| **f)
+                    .map(|(i, _)| i),
+            );
+            let outcome = |success, attempts| RemovalOutcome {
+                success,
+                attempts,
                 sweeps,
                 contacts,
                 fallbacks,
             };
+            if order.is_empty() {
+                return outcome(true, attempts);
+            }
+            if attempts >= budget {
+                return outcome(false, attempts);
+            }
+            order.shuffle(rng);
+            let cells = if uses_rng(rule) {
+                None
+            } else {
+                SweepCells::choose(state, list, rng)
+            };
+            let swept = match cells {
+                Some(cells) => sweep_cells(
+                    state,
+                    list,
+                    &mut tracker,
+                    &order,
+                    &cells,
+                    rule,
+                    tol,
+                    budget,
+                    &mut attempts,
+                    team,
+                ),
+                None => sweep(
+                    state,
+                    list,
+                    &mut tracker,
+                    &order,
+                    rule,
+                    tol,
+                    budget,
+                    &mut attempts,
+                    batch,
+                    rng,
+                    team,
+                ),
+            };
+            sweeps += 1;
+            if swept.moves == 0 {
+                // every overlapping particle is stuck (no positive-rate contact): spend the budget
+                return RemovalOutcome {
+                    success: false,
+                    attempts: budget.max(attempts),
+                    sweeps,
+                    contacts,
+                    fallbacks,
+                };
+            }
         }
-    }
+    })
 }

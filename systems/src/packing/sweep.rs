@@ -3,9 +3,10 @@
 //! algorithm's results for any number of rayon threads.
 //!
 //! **Scan** ([`OverlapTracker`]). Which particles carry an overlap above the tolerance. The
-//! pair contacts of the Verlet list ([`NeighbourList::unique`]) are evaluated in parallel into
-//! one result per pair (each pair owns its cached Newton start, so the evaluations are
-//! independent), and the per-pair results are reduced serially in pair order. Between two
+//! pair contacts of the Verlet list ([`NeighbourList::unique`]) are evaluated in parallel on
+//! the removal's [`Team`], each task writing its own pairs' overlaps, Newton starts and cached
+//! contacts (a pair owns its two list entries, so the evaluations are independent); only the
+//! per-particle counts of pairs above the tolerance are updated serially, in pair order. Between two
 //! scans of one overlap removal only the particles that moved change their contacts, so after
 //! the first (full) scan only the pairs with a moved end are evaluated again; the others keep
 //! their overlap. This is exact up to the contact solver's own accuracy (~1e-13 D): the serial

@@ -8,7 +8,7 @@ use super::super::state::PackingState;
 use crate::geometry::superquadric::WarmStart;
 use crate::par::team::{Scatter, Team};
 
-/// Pairs per rayon task of the pair scan (a sphere pair costs ~20 ns, a superball pair ~1 us).
+/// Pairs per team task of the pair scan (a sphere pair costs ~20 ns, a superball pair ~1 us).
 const SCAN_CHUNK: usize = 64;
 
 /// The overlaps of the list's pairs between scans of one overlap removal (see the module
