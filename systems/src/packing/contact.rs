@@ -162,20 +162,35 @@ pub fn superquadric_contact(
     qb: DQuat,
     warm: &mut Option<sq::WarmStart>,
 ) -> PairContact {
+    superquadric_contact_near(a, xa, qa, b, xb, qb, warm, false)
+}
+
+/// [`superquadric_contact`]; `within`: the pair is known to lie within the solver's gap
+/// cut-off (its overlap bound is above it), so the centre-line reject is skipped
+/// ([`sq::contact_prepared_within`]: the same answer).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn superquadric_contact_near(
+    a: &Body,
+    xa: DVec3,
+    qa: DQuat,
+    b: &Body,
+    xb: DVec3,
+    qb: DQuat,
+    warm: &mut Option<sq::WarmStart>,
+    within: bool,
+) -> PairContact {
     let opts = ContactOptions {
-        gap_cutoff: 0.05,
+        gap_cutoff: GAP_CUTOFF,
         ..ContactOptions::default()
     };
-    let r = sq::contact_prepared(
-        &a.contact_shape,
-        xa,
-        qa,
-        &b.contact_shape,
-        xb,
-        qb,
-        &opts,
-        warm.as_ref(),
-    );
+    let solve = if within {
+        sq::contact_prepared_within
+    } else {
+        sq::contact_prepared
+    };
+    let (sa, sb) = (&a.contact_shape, &b.contact_shape);
+    let r = solve(sa, xa, qa, sb, xb, qb, &opts, warm.as_ref());
     if r.warm.is_some() {
         *warm = r.warm;
     }
@@ -190,3 +205,7 @@ pub fn superquadric_contact(
         fallback: a.contact_approximate || b.contact_approximate || r.is_fallback(),
     }
 }
+
+/// Gap / D beyond which the packing's superquadric contacts are not computed exactly (the
+/// solver's `gap_cutoff`; far beyond the overlap tolerance and the contact-number window).
+pub(crate) const GAP_CUTOFF: f64 = 0.05;

@@ -14,13 +14,27 @@ use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
 pub use super::body::{Body, BodyKind};
-use super::contact::{PairContact, pair_contact, superquadric_contact};
+use super::contact::{PairContact, pair_contact, superquadric_contact, superquadric_contact_near};
 use super::walls::{self, WallContact, WallKind};
 use crate::geometry::superquadric::{WarmStart, overlap_upper_bound};
 
 /// Round-off margin / D of [`PackingState::contact_warm_above`]'s bound test (the bound's own
 /// error is ~1e-15 D, the solver's ~1e-13 D).
 const BOUND_MARGIN: f64 = 1e-10;
+
+/// What [`PackingState::contact_warm_above`] found for a pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Above {
+    /// The contact, if its overlap is above the tolerance.
+    pub contact: Option<PairContact>,
+    /// Room / D left below the tolerance: the overlap is at most `tol` - 1e-10 - `room`
+    /// (>= 0; negative infinity when no such bound is known: rod pairs, contacts above the
+    /// tolerance, solver fall-backs). The overlap of two convex bodies changes by no more
+    /// than how far their surface points move, so it stays at most the tolerance while the
+    /// two ends together move their points by less than `room` (the overlap tracker's
+    /// certificates).
+    pub room: f64,
+}
 
 /// Positions, orientations and bodies of all particles in a container, reduced units.
 #[derive(Debug, Clone, PartialEq)]
@@ -167,7 +181,7 @@ impl PackingState {
         superquadric_contact(bi, xi, qi, bj, xj, qj, warm)
     }
 
-    /// [`Self::contact_warm`] if the pair overlaps by more than `tol`, else None. A
+    /// [`Self::contact_warm`] if the pair overlaps by more than `tol` (see [`Above`]). A
     /// superquadric pair whose overlap is certainly at most `tol` (its separating-axis bound
     /// along the cached contact normal, [`overlap_upper_bound`], below `tol` less a round-off
     /// margin) is not solved and keeps its cached Newton start: its solved overlap would be
@@ -180,7 +194,7 @@ impl PackingState {
         shift: DVec3,
         warm: &mut Option<WarmStart>,
         tol: f64,
-    ) -> Option<PairContact> {
+    ) -> Above {
         let (xi, qi) = (self.positions[i], self.orientations[i]);
         let (xj, qj) = (self.positions[j] + shift, self.orientations[j]);
         self.contact_warm_above_at(i, (xi, qi), j, (xj, qj), warm, tol)
@@ -196,24 +210,51 @@ impl PackingState {
         pose_j: (DVec3, DQuat),
         warm: &mut Option<WarmStart>,
         tol: f64,
-    ) -> Option<PairContact> {
+    ) -> Above {
         let (bi, bj) = (&self.bodies[i], &self.bodies[j]);
-        if self.is_superquadric_pair(i, j) {
-            let bound = overlap_upper_bound(
-                &bi.contact_shape,
-                pose_i.0,
-                pose_i.1,
-                &bj.contact_shape,
-                pose_j.0,
-                pose_j.1,
-                warm.as_ref(),
-            );
-            if bound <= tol - BOUND_MARGIN {
-                return None;
-            }
+        if !self.is_superquadric_pair(i, j) {
+            let c = self.contact_warm_at(i, pose_i, j, pose_j, warm);
+            return Above {
+                contact: (c.overlap > tol).then_some(c),
+                room: f64::NEG_INFINITY,
+            };
         }
-        let c = self.contact_warm_at(i, pose_i, j, pose_j, warm);
-        (c.overlap > tol).then_some(c)
+        let (ci, cj) = (&bi.contact_shape, &bj.contact_shape);
+        let bound = overlap_upper_bound(
+            ci,
+            pose_i.0,
+            pose_i.1,
+            cj,
+            pose_j.0,
+            pose_j.1,
+            warm.as_ref(),
+        );
+        if bound <= tol - BOUND_MARGIN {
+            return Above {
+                contact: None,
+                room: tol - BOUND_MARGIN - bound,
+            };
+        }
+        // the bound is above the tolerance, so far above the solver's gap cut-off: the
+        // solver's centre-line reject cannot end the call
+        let (xi, qi) = pose_i;
+        let (xj, qj) = pose_j;
+        let c = superquadric_contact_near(bi, xi, qi, bj, xj, qj, warm, true);
+        if c.overlap > tol {
+            return Above {
+                contact: Some(c),
+                room: f64::NEG_INFINITY,
+            };
+        }
+        let room = tol - BOUND_MARGIN - c.overlap;
+        Above {
+            contact: None,
+            room: if c.fallback || room.is_nan() {
+                f64::NEG_INFINITY
+            } else {
+                room
+            },
+        }
     }
 
     /// Wall contacts of particle `i` with overlap > `-margin` (virtual rods for spheres and

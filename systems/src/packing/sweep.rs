@@ -29,6 +29,15 @@
 //! ([`PackingState::contact_warm_above`]; the cache records it as such): in the dense regime
 //! about three quarters of the pair evaluations end there.
 //!
+//! **Certificates.** The overlap of two convex bodies changes by no more than how far their
+//! surface points move. So a pair that a scan found below the tolerance by some room (its
+//! bound or solved overlap, [`PackingState::contact_warm_above`]) stays below it until its
+//! two ends have together moved their points by that room; the tracker keeps each particle's
+//! travel (the sum of its moves' translations and turn bounds) and skips such pairs in scans
+//! and moves without evaluating them ([`OverlapTracker::certified`]). The answer is the one an
+//! evaluation would give (at most the tolerance); only the Newton start of a pair that would
+//! have been solved below the tolerance is not refreshed.
+//!
 //! **Sweep** ([`sweep`]). The serial sweep moves the flagged particles one after the other in a
 //! shuffled order, each with its contacts evaluated at that moment. The move of particle i
 //! reads only the poses of i and of its listed neighbours and the cached Newton starts of i's
@@ -139,14 +148,20 @@ pub fn contacts_with(
             let pose_j = (xj + nb.shift(state.edges), qj);
             state.contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
         } else {
-            if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, j)) {
-                if let Some(c) = c.filter(|c| c.overlap > tol) {
-                    out.push(c);
+            if let Some(t) = tracker {
+                if let Some(c) = t.cached(list, k, i, j) {
+                    if let Some(c) = c.filter(|c| c.overlap > tol) {
+                        out.push(c);
+                    }
+                    continue;
                 }
-                continue;
+                if t.certified(list, k, i, j) {
+                    continue;
+                }
             }
             state.contact_warm_above(i, j, nb.shift(state.edges), &mut w, tol)
-        };
+        }
+        .contact;
         if !same_bits(&w, &old) {
             warm.push((k as u32, w));
         }
@@ -211,7 +226,8 @@ pub(crate) fn commit_counted(
     if moved {
         *attempts += 1;
         count.moves += 1;
-        tracker.note_moved(i);
+        let travel = p.displacement.map_or(0.0, |d| d.dx.length() + p.turn);
+        tracker.note_moved(i, travel);
     }
     moved
 }

@@ -81,6 +81,59 @@ pub fn contact_prepared(
     opts: &ContactOptions,
     warm: Option<&WarmStart>,
 ) -> ContactResult {
+    prepared_pair(a, xa, qa, b, xb, qb, opts, warm, true)
+}
+
+/// [`contact_prepared`] for a pair known to lie within the cut-off
+/// c = max(`gap_cutoff`, `newton_band` L), for instance one whose [`overlap_upper_bound`]
+/// is above -c: the separating-axis reject along the centre line, which cannot end the call
+/// of such a pair (that bound is at least the true overlap, so not below -c), is skipped.
+/// The answer is [`contact_prepared`]'s whenever that reject would not have ended the call;
+/// for a pair that is in fact farther apart it is still a correct contact (computed by the
+/// warm start or GJK instead of the reject). A packing calls it after its bound test, so a
+/// pair near contact costs two support points less.
+///
+/// ```
+/// use glam::{DQuat, DVec3};
+/// use magsep_systems::geometry::superquadric::{
+///     contact_prepared, contact_prepared_within, ContactOptions, PreparedShape, Superquadric,
+/// };
+/// let p = PreparedShape::new(&Superquadric::superball(0.5, 3.0));
+/// let o = ContactOptions::default();
+/// let (q, x) = (DQuat::from_rotation_z(0.3), DVec3::new(0.97, 0.05, 0.0));
+/// let full = contact_prepared(&p, DVec3::ZERO, DQuat::IDENTITY, &p, x, q, &o, None);
+/// let within = contact_prepared_within(&p, DVec3::ZERO, DQuat::IDENTITY, &p, x, q, &o, None);
+/// assert_eq!(full, within);
+/// ```
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn contact_prepared_within(
+    a: &PreparedShape,
+    xa: DVec3,
+    qa: DQuat,
+    b: &PreparedShape,
+    xb: DVec3,
+    qb: DQuat,
+    opts: &ContactOptions,
+    warm: Option<&WarmStart>,
+) -> ContactResult {
+    prepared_pair(a, xa, qa, b, xb, qb, opts, warm, false)
+}
+
+/// The two functions above; `centre_line`: try the centre-line reject.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn prepared_pair(
+    a: &PreparedShape,
+    xa: DVec3,
+    qa: DQuat,
+    b: &PreparedShape,
+    xb: DVec3,
+    qb: DQuat,
+    opts: &ContactOptions,
+    warm: Option<&WarmStart>,
+    centre_line: bool,
+) -> ContactResult {
     let finite = xa.is_finite() && xb.is_finite() && qa.is_finite() && qb.is_finite();
     if !(finite && a.valid && b.valid && qa.length() > 0.0 && qb.length() > 0.0) {
         return invalid();
@@ -99,7 +152,8 @@ pub fn contact_prepared(
     let inner = a.min_axis + b.min_axis;
     let scale = a.min_axis.min(b.min_axis);
     let s = pose_setup(a.prepared, b.prepared, scale, xa, qa, xb, qb);
-    solve_pair(&s, dist, (inner - dist, outer - dist), opts, warm)
+    let bounds = (inner - dist, outer - dist);
+    solve_pair(&s, dist, bounds, opts, warm, centre_line)
 }
 
 /// An upper bound of the overlap \[m\] that [`contact_prepared`] computes for the same poses

@@ -326,7 +326,7 @@ pub fn contact(
         return far_apart(s.d, dist, outer);
     }
     let inner = a.semi_axes.min_element() + b.semi_axes.min_element();
-    solve_pair(&s, dist, (inner - dist, outer - dist), opts, warm)
+    solve_pair(&s, dist, (inner - dist, outer - dist), opts, warm, true)
 }
 
 /// The [`ContactStatus::FarApart`] answer for centres `d` = x_b - x_a at distance `dist`
@@ -344,13 +344,16 @@ pub(super) fn far_apart(d: DVec3, dist: f64, bound: f64) -> ContactResult {
 }
 
 /// [`contact`] after the bounding-sphere rejects: `bounds` = (inscribed, circumscribed)
-/// sphere bounds of the overlap.
+/// sphere bounds of the overlap. `centre_line`: try the separating-axis reject along the
+/// centre line first (skipped by callers that know the pair lies within the cut-off, where
+/// it cannot end the call).
 pub(super) fn solve_pair(
     s: &Setup,
     dist: f64,
     bounds: (f64, f64),
     opts: &ContactOptions,
     warm: Option<&WarmStart>,
+    centre_line: bool,
 ) -> ContactResult {
     let tol = if opts.tolerance > 0.0 {
         opts.tolerance
@@ -393,7 +396,7 @@ pub(super) fn solve_pair(
     // separating-axis test along the centre line: a gap beyond the cutoff ends here, before
     // any warm start, GJK or Newton (the same answer class as GJK's early exit)
     let cutoff = opts.gap_cutoff.max(opts.newton_band * s.scale);
-    if opts.polish && cutoff.is_finite() && dist > 0.0 {
+    if centre_line && opts.polish && cutoff.is_finite() && dist > 0.0 {
         let u = s.d / dist;
         let (ua, ub) = (s.qa.conjugate() * u, s.qb.conjugate() * -u);
         let (sa, sb) = (s.pa.support(ua), s.pb.support(ub));

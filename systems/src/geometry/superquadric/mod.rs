@@ -85,7 +85,7 @@ mod tests_contact;
 #[cfg(test)]
 mod tests_random;
 
-pub use cached::{PreparedShape, contact_prepared, overlap_upper_bound};
+pub use cached::{PreparedShape, contact_prepared, contact_prepared_within, overlap_upper_bound};
 pub use contact::{
     ContactOptions, ContactResult, ContactStatus, GjkEpaContact, WarmStart, contact,
     gjk_epa_contact,

@@ -60,6 +60,7 @@ fn prepared_contact_equals_reference_bitwise() {
         },
     ];
     let mut statuses = std::collections::HashSet::new();
+    let mut skipped_rejects = 0;
     for case in 0..3000 {
         let (a, b) = (random_shape(&mut r), random_shape(&mut r));
         let (pa, pb) = (PreparedShape::new(&a), PreparedShape::new(&b));
@@ -78,6 +79,24 @@ fn prepared_contact_equals_reference_bitwise() {
                 "case {case}: {fast:?} vs {reference:?}"
             );
             statuses.insert(fast.status);
+            // without the centre-line reject: the same answer unless that reject ended the
+            // call (then a gap beyond the cut-off either way)
+            let within =
+                contact_prepared_within(&pa, DVec3::ZERO, qa, &pb, xb, qb, &opts, warm.as_ref());
+            if bits(&within) != bits(&fast) {
+                // only where the centre-line reject ended the call: a gap beyond the cut-off
+                // either way
+                let l = a.semi_axes.min_element().min(b.semi_axes.min_element());
+                let cutoff = opts.gap_cutoff.max(opts.newton_band * l);
+                let rejected = opts.polish && cutoff.is_finite() && fast.iterations == 0;
+                assert!(
+                    rejected
+                        && fast.status == ContactStatus::SeparatedGjk
+                        && within.overlap < -cutoff + 1e-9 * reach,
+                    "case {case}: {within:?} vs {fast:?}"
+                );
+                skipped_rejects += 1;
+            }
             if fast.warm.is_some() {
                 warm = fast.warm;
             }
@@ -94,6 +113,7 @@ fn prepared_contact_equals_reference_bitwise() {
     ] {
         assert!(statuses.contains(&st), "{st:?} never reached: {statuses:?}");
     }
+    assert!(skipped_rejects > 20, "{skipped_rejects}");
 }
 
 #[test]

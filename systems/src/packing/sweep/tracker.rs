@@ -33,6 +33,12 @@ pub struct OverlapTracker {
     selected: Vec<u32>,
     /// Moves of each particle since the last full scan (the contact cache's clock).
     version: Vec<u32>,
+    /// Per particle: how far its surface points have moved since the last full scan, at
+    /// most (the sum of its moves' translations and turn bounds) / D.
+    travel: Vec<f64>,
+    /// Per pair of [`NeighbourList::unique`]: the pair's overlap stays at most the tolerance
+    /// while the travels of its two ends sum to less than this (see [`Self::certified`]).
+    clear: Vec<f64>,
     /// Per directed list entry: the superquadric pair contact of the last scan, with the
     /// versions of both ends it was computed at (see [`Self::cached`]).
     cache: Vec<Option<CachedContact>>,
@@ -80,15 +86,19 @@ impl OverlapTracker {
         Self::default()
     }
 
-    /// Record that particle `i` moved.
-    pub fn note_moved(&mut self, i: usize) {
+    /// Record that particle `i` moved, its surface points by at most `travel` / D.
+    pub fn note_moved(&mut self, i: usize, travel: f64) {
         if self.moved_mark.len() <= i {
             self.moved_mark.resize(i + 1, false);
         }
         if self.version.len() <= i {
             self.version.resize(i + 1, 0);
         }
+        if self.travel.len() <= i {
+            self.travel.resize(i + 1, 0.0);
+        }
         self.version[i] = self.version[i].wrapping_add(1);
+        self.travel[i] += travel;
         if !self.moved_mark[i] {
             self.moved_mark[i] = true;
             self.moved.push(i as u32);
@@ -122,6 +132,24 @@ impl OverlapTracker {
         (c.version_i == v(i) && c.version_j == v(j)).then_some(c.contact)
     }
 
+    /// Whether the overlap of the pair of list entry `k` (particle `i` with its neighbour `j`,
+    /// both at their poses in the state) is certainly at most the tolerance of the last scan
+    /// without evaluating it: a scan found room r below the tolerance ([`crate::packing::state::Above::room`]) when
+    /// the travels of the two ends summed to T, and they have moved since by less than r
+    /// together. The overlap of two convex bodies changes by no more than how far their
+    /// surface points move (each separating-axis bound h_a(u) + h_b(-u) - d.u along a fixed
+    /// direction u does, and the overlap is their minimum), so it is still below the
+    /// tolerance less the round-off margin.
+    #[inline]
+    pub fn certified(&self, list: &NeighbourList, k: usize, i: usize, j: usize) -> bool {
+        if self.built != Some(list.builds) {
+            return false;
+        }
+        let clear = self.clear.get(list.pair_of_entry(k)).copied();
+        let t = |p: usize| self.travel.get(p).copied().unwrap_or(f64::INFINITY);
+        clear.is_some_and(|c| t(i) + t(j) < c)
+    }
+
     /// Set `flags[i]` for every particle with a pair or wall overlap above `tol`, evaluating
     /// the pairs with a moved end (all pairs on the first scan or after a rebuild). The list
     /// must be valid (`NeighbourList::ensure`).
@@ -152,6 +180,10 @@ impl OverlapTracker {
             self.wall.resize(n, false);
             self.version.clear();
             self.version.resize(n, 0);
+            self.travel.clear();
+            self.travel.resize(n, 0.0);
+            self.clear.clear();
+            self.clear.resize(npairs, f64::NEG_INFINITY);
             self.cache.clear();
             self.cache.resize(list.len(), None);
             self.selected.extend(0..npairs as u32);
@@ -211,10 +243,11 @@ impl OverlapTracker {
     ) -> ScanCount {
         let (pairs, twins, warm) = list.pairs_and_warm();
         let selected = &self.selected;
-        let version = &self.version;
+        let (version, travel) = (&self.version, &self.travel);
         let warm = Scatter::new(warm);
         let overlap = Scatter::new(&mut self.overlap);
         let cache = Scatter::new(&mut self.cache);
+        let clear = Scatter::new(&mut self.clear);
         let chunks = team.map(selected.len().div_ceil(SCAN_CHUNK), |c| {
             let end = ((c + 1) * SCAN_CHUNK).min(selected.len());
             let mut out = ScanChunk::default();
@@ -224,11 +257,24 @@ impl OverlapTracker {
                 let (i, j, k) = (e.i as usize, e.j as usize, e.k as usize);
                 let twin = twins[k] as usize;
                 // SAFETY: `selected` holds each pair once, and the indices touched here are
-                // the pair's own: its overlap p and its two directed entries k and twin
+                // the pair's own: its overlap and certificate p and its two directed entries
+                // k and twin
                 unsafe {
+                    let (vi, vj) = (version[i], version[j]);
+                    let moved = travel[i] + travel[j];
+                    if moved < clear.read(p) {
+                        // still certainly at most the tolerance (see `certified`): the
+                        // overlap was at most the tolerance and stays so, and the cache
+                        // records the answer at the present versions as an evaluation would
+                        cache.write(k, Some(CachedContact::new(vi, vj, None)));
+                        cache.write(twin, Some(CachedContact::new(vj, vi, None)));
+                        continue;
+                    }
                     let mut w = warm.read(k);
-                    let c = state.contact_warm_above(i, j, e.shift(state.edges), &mut w, tol);
+                    let above = state.contact_warm_above(i, j, e.shift(state.edges), &mut w, tol);
                     out.count.contacts += 1;
+                    clear.write(p, moved + above.room);
+                    let c = above.contact;
                     let new = c.as_ref().map_or(f64::NEG_INFINITY, |c| c.overlap);
                     let (was, is) = (overlap.read(p) > tol, new > tol);
                     if was != is {
@@ -236,7 +282,6 @@ impl OverlapTracker {
                     }
                     overlap.write(p, new);
                     let sq = state.is_superquadric_pair(i, j);
-                    let (vi, vj) = (version[i], version[j]);
                     let Some(c) = c else {
                         // at most the tolerance, not solved: the Newton starts stay as they are
                         if sq {
