@@ -365,6 +365,7 @@ pub(super) fn solve_pair(
         tol,
         max_iter: opts.max_iterations,
         scale: s.scale,
+        chord: true,
     };
     let done = |overlap: f64, u_b: DVec3, s_a: DVec3, s_b: DVec3, status, iterations, warm| {
         ContactResult {
