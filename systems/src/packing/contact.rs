@@ -162,35 +162,30 @@ pub fn superquadric_contact(
     qb: DQuat,
     warm: &mut Option<sq::WarmStart>,
 ) -> PairContact {
-    superquadric_contact_near(a, xa, qa, b, xb, qb, warm, false)
+    let (sa, sb) = (&a.contact_shape, &b.contact_shape);
+    let r = sq::contact_prepared(sa, xa, qa, sb, xb, qb, &solver_options(), warm.as_ref());
+    from_solver(r, a, b, warm)
 }
 
-/// [`superquadric_contact`]; `within`: the pair is known to lie within the solver's gap
-/// cut-off (its overlap bound is above it), so the centre-line reject is skipped
-/// ([`sq::contact_prepared_within`]: the same answer).
-#[allow(clippy::too_many_arguments)]
+/// The packing's options of the superquadric contact solver: the defaults, with gaps beyond
+/// 0.05 D not computed exactly (far beyond the overlap tolerance and the contact-number
+/// window).
 #[inline]
-pub(crate) fn superquadric_contact_near(
-    a: &Body,
-    xa: DVec3,
-    qa: DQuat,
-    b: &Body,
-    xb: DVec3,
-    qb: DQuat,
-    warm: &mut Option<sq::WarmStart>,
-    within: bool,
-) -> PairContact {
-    let opts = ContactOptions {
-        gap_cutoff: GAP_CUTOFF,
+pub(crate) fn solver_options() -> ContactOptions {
+    ContactOptions {
+        gap_cutoff: 0.05,
         ..ContactOptions::default()
-    };
-    let solve = if within {
-        sq::contact_prepared_within
-    } else {
-        sq::contact_prepared
-    };
-    let (sa, sb) = (&a.contact_shape, &b.contact_shape);
-    let r = solve(sa, xa, qa, sb, xb, qb, &opts, warm.as_ref());
+    }
+}
+
+/// The pair contact of a solver answer `r` for bodies `a`, `b`; its Newton start, if any,
+/// replaces `warm`.
+pub(crate) fn from_solver(
+    r: sq::ContactResult,
+    a: &Body,
+    b: &Body,
+    warm: &mut Option<sq::WarmStart>,
+) -> PairContact {
     if r.warm.is_some() {
         *warm = r.warm;
     }
@@ -205,7 +200,3 @@ pub(crate) fn superquadric_contact_near(
         fallback: a.contact_approximate || b.contact_approximate || r.is_fallback(),
     }
 }
-
-/// Gap / D beyond which the packing's superquadric contacts are not computed exactly (the
-/// solver's `gap_cutoff`; far beyond the overlap tolerance and the contact-number window).
-pub(crate) const GAP_CUTOFF: f64 = 0.05;

@@ -14,9 +14,11 @@ use glam::{DQuat, DVec3};
 use magsep_components::shape::Shape;
 
 pub use super::body::{Body, BodyKind};
-use super::contact::{PairContact, pair_contact, superquadric_contact, superquadric_contact_near};
+use super::contact::{
+    PairContact, from_solver, pair_contact, solver_options, superquadric_contact,
+};
 use super::walls::{self, WallContact, WallKind};
-use crate::geometry::superquadric::{WarmStart, overlap_upper_bound};
+use crate::geometry::superquadric::{WarmStart, contact_prepared_within, overlap_upper_bound};
 
 /// Round-off margin / D of [`PackingState::contact_warm_above`]'s bound test (the bound's own
 /// error is ~1e-15 D, the solver's ~1e-13 D).
@@ -237,9 +239,10 @@ impl PackingState {
         }
         // the bound is above the tolerance, so far above the solver's gap cut-off: the
         // solver's centre-line reject cannot end the call
-        let (xi, qi) = pose_i;
-        let (xj, qj) = pose_j;
-        let c = superquadric_contact_near(bi, xi, qi, bj, xj, qj, warm, true);
+        let (xi, qi, xj, qj) = (pose_i.0, pose_i.1, pose_j.0, pose_j.1);
+        let opts = solver_options();
+        let r = contact_prepared_within(ci, xi, qi, cj, xj, qj, &opts, warm.as_ref());
+        let c = from_solver(r, bi, bj, warm);
         if c.overlap > tol {
             return Above {
                 contact: Some(c),

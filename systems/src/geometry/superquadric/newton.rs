@@ -58,22 +58,12 @@ pub(crate) struct System {
 }
 
 impl System {
-    /// The system at (s_a, s_b) ([`system`]).
-    #[cfg(test)]
-    pub(crate) fn at(
-        pair: &PairFrame,
-        s_a: DVec3,
-        s_b: DVec3,
-        ea: &Eval,
-        eb: &Eval,
-        fr: &Frame,
-    ) -> Self {
-        let mut sys = Self {
+    /// All zeros (to be filled by [`system`]).
+    pub(crate) fn zero() -> Self {
+        Self {
             phi: [0.0; 6],
             jac: [[0.0; 6]; 6],
-        };
-        system(&mut sys, pair, s_a, s_b, ea, eb, fr);
-        sys
+        }
     }
 }
 
@@ -317,10 +307,7 @@ pub(crate) fn solve(
     let mut prev_step = f64::INFINITY;
     // the last full iteration's system, factored in place, with its permutation and row
     // scales (for a closing chord step)
-    let mut sys = System {
-        phi: [0.0; 6],
-        jac: [[0.0; 6]; 6],
-    };
+    let mut sys = System::zero();
     let mut chord: Option<([usize; 6], [f64; 6])> = None;
     let mut out = Newton {
         s_a,
