@@ -122,71 +122,92 @@ pub(crate) fn system(
 }
 
 /// Solves `m x = rhs` (LU, partial pivoting) by [`lu_factor`] and [`lu_solve`]; false for a
-/// zero or non-finite pivot. The rows are pivoted through a permutation instead of being
-/// swapped in memory; the arithmetic is that of `solve6_reference` operation for operation, so
-/// the answer is the same bit for bit (tested).
+/// zero or non-finite pivot. The arithmetic is that of `solve6_reference` operation for
+/// operation, so the answer is the same bit for bit (tested).
 #[cfg(test)]
 pub(crate) fn solve6(m: &mut [[f64; 6]; 6], rhs: &mut [f64; 6]) -> bool {
     lu_factor(m).is_some_and(|p| lu_solve(m, &p, rhs))
 }
 
-/// LU factorisation with partial pivoting of `m` in place: row p[r] holds the pivoted row r,
-/// its multipliers below the diagonal and U on and above it. Returns the permutation p, None
-/// for a zero or non-finite pivot. [`lu_solve`] repeats the elimination's operations on a
-/// right-hand side in the same order, so factor-then-solve is the reference's arithmetic.
+/// LU factorisation with partial pivoting of `m` in place (LAPACK's layout): rows are swapped
+/// in memory, step `c` swapping rows c and p\[c\]; the unit lower factor's multipliers are
+/// stored below the diagonal, U above it and the reciprocals of U's diagonal on it (the back
+/// substitution multiplies instead of dividing: six divisions in a row were its latency).
+/// Returns the swaps p, None for a zero or non-finite pivot. [`lu_solve`] repeats the
+/// elimination's operations on a right-hand side in the same order, so factor-then-solve is
+/// the reference's arithmetic.
+///
+/// Hand-written rather than a linear-algebra crate's: it is the hot kernel of every contact
+/// solve, and with constant bounds the compiler unrolls it into straight-line code.
 #[inline]
-pub(crate) fn lu_factor(m: &mut [[f64; 6]; 6]) -> Option<[usize; 6]> {
-    let mut p = [0usize, 1, 2, 3, 4, 5];
-    for col in 0..6 {
-        let mut piv = col;
-        let mut best = m[p[col]][col].abs();
-        for (r, &pr) in p.iter().enumerate().skip(col + 1) {
-            if m[pr][col].abs() > best {
-                best = m[pr][col].abs();
-                piv = r;
-            }
-        }
-        if !(best.is_finite() && best > 0.0) {
-            return None;
-        }
-        p.swap(col, piv);
-        let pivot_row = m[p[col]];
-        let inv = 1.0 / pivot_row[col];
-        for &pr in &p[col + 1..] {
-            let f = m[pr][col] * inv;
-            if f != 0.0 {
-                for (x, q) in m[pr][col + 1..].iter_mut().zip(&pivot_row[col + 1..]) {
-                    *x -= f * q;
+pub(crate) fn lu_factor(m: &mut [[f64; 6]; 6]) -> Option<[u8; 6]> {
+    let mut p = [0u8; 6];
+    // one elimination step per column, written out so that every loop has constant bounds
+    // and unrolls into straight-line code
+    macro_rules! step {
+        ($col:literal) => {{
+            let mut piv = $col;
+            let mut best = m[$col][$col].abs();
+            for r in 0..6 {
+                if r > $col && m[r][$col].abs() > best {
+                    best = m[r][$col].abs();
+                    piv = r;
                 }
             }
-            m[pr][col] = f;
-        }
+            if !(best.is_finite() && best > 0.0) {
+                return None;
+            }
+            m.swap($col, piv);
+            p[$col] = piv as u8;
+            let pivot_row = m[$col];
+            let inv = 1.0 / pivot_row[$col];
+            m[$col][$col] = inv;
+            for r in 0..6 {
+                if r > $col {
+                    let f = m[r][$col] * inv;
+                    for c in 0..6 {
+                        if c > $col {
+                            m[r][c] -= f * pivot_row[c];
+                        }
+                    }
+                    m[r][$col] = f;
+                }
+            }
+        }};
     }
+    step!(0);
+    step!(1);
+    step!(2);
+    step!(3);
+    step!(4);
+    step!(5);
     Some(p)
 }
 
 /// Solve with the factors of [`lu_factor`] in place; false for a non-finite answer.
 #[inline]
-pub(crate) fn lu_solve(m: &[[f64; 6]; 6], p: &[usize; 6], rhs: &mut [f64; 6]) -> bool {
-    let rows = p.map(|r| &m[r]);
-    let mut y = p.map(|r| rhs[r]);
+pub(crate) fn lu_solve(m: &[[f64; 6]; 6], p: &[u8; 6], rhs: &mut [f64; 6]) -> bool {
+    let mut y = *rhs;
+    for (col, &r) in p.iter().enumerate() {
+        y.swap(col, r as usize);
+    }
     for col in 0..6 {
-        for r in col + 1..6 {
-            let f = rows[r][col];
-            if f != 0.0 {
-                y[r] -= f * y[col];
+        for r in 0..6 {
+            if r > col {
+                y[r] -= m[r][col] * y[col];
             }
         }
     }
-    let mut x = [0.0; 6];
     for col in (0..6).rev() {
         let mut acc = y[col];
-        for c in col + 1..6 {
-            acc -= rows[col][c] * x[c];
+        for c in 0..6 {
+            if c > col {
+                acc -= m[col][c] * y[c];
+            }
         }
-        x[col] = acc / rows[col][col];
+        y[col] = acc * m[col][col];
     }
-    *rhs = x;
+    *rhs = y;
     rhs.iter().all(|v| v.is_finite())
 }
 
@@ -210,13 +231,11 @@ pub(crate) fn solve6_reference(m: &mut [[f64; 6]; 6], rhs: &mut [f64; 6]) -> boo
         let inv = 1.0 / m[col][col];
         for r in col + 1..6 {
             let f = m[r][col] * inv;
-            if f != 0.0 {
-                let pivot_row = m[col];
-                for (x, p) in m[r][col..].iter_mut().zip(&pivot_row[col..]) {
-                    *x -= f * p;
-                }
-                rhs[r] -= f * rhs[col];
+            let pivot_row = m[col];
+            for (x, p) in m[r][col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= f * p;
             }
+            rhs[r] -= f * rhs[col];
         }
     }
     for col in (0..6).rev() {
@@ -224,7 +243,7 @@ pub(crate) fn solve6_reference(m: &mut [[f64; 6]; 6], rhs: &mut [f64; 6]) -> boo
         for c in col + 1..6 {
             acc -= m[col][c] * rhs[c];
         }
-        rhs[col] = acc / m[col][col];
+        rhs[col] = acc * (1.0 / m[col][col]);
     }
     rhs.iter().all(|v| v.is_finite())
 }
@@ -308,7 +327,7 @@ pub(crate) fn solve(
     // the last full iteration's system, factored in place, with its permutation and row
     // scales (for a closing chord step)
     let mut sys = System::zero();
-    let mut chord: Option<([usize; 6], [f64; 6])> = None;
+    let mut chord: Option<([u8; 6], [f64; 6])> = None;
     let mut out = Newton {
         s_a,
         s_b,
