@@ -392,7 +392,8 @@ pub(crate) fn solve(
         chord = perm.map(|p| (p, scale));
         let da = DVec3::new(rhs[0], rhs[1], rhs[2]);
         let db = DVec3::new(rhs[3], rhs[4], rhs[5]);
-        let step = (da.length_squared() + db.length_squared()).sqrt();
+        let (la, lb) = (da.length_squared(), db.length_squared());
+        let step = (la + lb).sqrt();
         let quadratic = it > 0
             && step <= 1e-6 * l
             && step <= 0.01 * prev_step
@@ -406,15 +407,22 @@ pub(crate) fn solve(
             out.converged = true;
             return out;
         }
-        let alpha = 1.0f64
-            .min(rho_a / da.length().max(1e-300))
-            .min(rho_b / db.length().max(1e-300));
-        if alpha < 1.0 {
-            // a damped step: the chord's error estimate assumes the full step
-            chord = None;
+        if la <= rho_a * rho_a && lb <= rho_b * rho_b {
+            // inside the trust region: the full step (alpha = 1 exactly), without the square
+            // roots and divisions of the damping factor on the iteration's critical path
+            s_a += da;
+            s_b += db;
+        } else {
+            let alpha = 1.0f64
+                .min(rho_a / da.length().max(1e-300))
+                .min(rho_b / db.length().max(1e-300));
+            if alpha < 1.0 {
+                // a damped step: the chord's error estimate assumes the full step
+                chord = None;
+            }
+            s_a += alpha * da;
+            s_b += alpha * db;
         }
-        s_a += alpha * da;
-        s_b += alpha * db;
         if !(s_a.is_finite() && s_b.is_finite()) {
             break;
         }
