@@ -108,4 +108,5 @@ if ! cmp "$work/local/results.csv" "$work/slurm/results.csv"; then
   fail "the merged Slurm results differ from the local sweep's"
 fi
 rows=$(( $(wc -l < "$work/local/results.csv") - 1 ))
-echo "ci_sweep_test: passed ($rows result rows identical; outputs in $work)"
+rm -rf "$work"
+echo "ci_sweep_test: passed ($rows result rows identical)"

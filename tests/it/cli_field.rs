@@ -12,9 +12,7 @@ fn magsep(args: &[&str]) -> Output {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("magsep-cli-field-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    crate::common::tmp_path("cli_field", name)
 }
 
 fn stdout(o: &Output) -> String {

@@ -29,9 +29,7 @@ every = 1000
 
 /// Run `text` with a recording; the final frame's worst wall penetration / D, and the summary.
 fn run_recorded(text: &str, tag: &str) -> (f64, serde_json::Value, std::path::PathBuf) {
-    let dir = std::env::temp_dir().join(format!("magsep-walls-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("run.mcap");
+    let path = crate::common::tmp_path("packing_walls", &format!("{tag}.mcap"));
     let s = parse_scene(text, &Default::default()).unwrap();
     let mut sim = Simulation::from_scene(
         &s,

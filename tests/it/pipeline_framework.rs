@@ -18,9 +18,7 @@ fn brownian() -> String {
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("magsep-framework-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    crate::common::tmp_path("pipeline_framework", name)
 }
 
 #[test]

@@ -522,6 +522,9 @@ fn record_write_sample_for_python_check() {
     let rec = read_recording(&path).unwrap();
     assert_eq!(rec.frames.len(), 20);
     assert!(rec.truncated.is_none());
+    if std::env::var("MAGSEP_WRITE_SAMPLE").is_err() {
+        std::fs::remove_file(&path).ok();
+    }
 }
 
 #[test]
