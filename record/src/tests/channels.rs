@@ -1,6 +1,6 @@
 //! Tests of plugin channels, plugin metadata and self-describing schemas.
 
-use super::{TempFile, assert_frames_bitwise_eq, metadata, random_frames};
+use super::{TempFile, assert_frames_bitwise_eq, metadata, random_frames, sample_target};
 use crate::schema::field_comments;
 use crate::*;
 use prost::Message as _;
@@ -260,19 +260,9 @@ fn record_metadata_plugins_and_extra_round_trip() {
 /// `MAGSEP_WRITE_CUSTOM_SAMPLE` (for the Python check), else to a temporary file.
 #[test]
 fn record_write_custom_channel_sample_for_python_check() {
-    let target = std::env::var("MAGSEP_WRITE_CUSTOM_SAMPLE")
-        .ok()
-        .filter(|t| t.ends_with(".mcap"))
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| {
-            std::env::temp_dir().join(format!("magsep-custom-{}.mcap", std::process::id()))
-        });
-    let temporary = std::env::var("MAGSEP_WRITE_CUSTOM_SAMPLE").is_err();
+    let (target, _temp) = sample_target("MAGSEP_WRITE_CUSTOM_SAMPLE", "custom.mcap");
     write_with_channels(&target, true);
     let rec = crate::read_recording(&target).unwrap();
-    if temporary {
-        std::fs::remove_file(&target).ok();
-    }
     assert!(rec.truncated.is_none());
     let topics: Vec<&str> = rec.channels.iter().map(|c| c.topic.as_str()).collect();
     assert!(

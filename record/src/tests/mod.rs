@@ -32,6 +32,18 @@ impl TempFile {
     }
 }
 
+/// Where a sample for the Python checks goes: the `.mcap` path in the environment variable
+/// `var` (kept), else a [`TempFile`] named `name` (the guard, removed when dropped).
+pub(crate) fn sample_target(var: &str, name: &str) -> (PathBuf, Option<TempFile>) {
+    match std::env::var(var).ok().filter(|t| t.ends_with(".mcap")) {
+        Some(t) => (PathBuf::from(t), None),
+        None => {
+            let temp = TempFile::new(name);
+            (temp.to_path_buf(), Some(temp))
+        }
+    }
+}
+
 impl AsRef<std::path::Path> for TempFile {
     fn as_ref(&self) -> &std::path::Path {
         &self.0
@@ -476,13 +488,7 @@ fn record_writer_rejects_inconsistent_frames() {
 /// temporary file.
 #[test]
 fn record_write_sample_for_python_check() {
-    let path = std::env::var("MAGSEP_WRITE_SAMPLE")
-        .ok()
-        .filter(|t| t.ends_with(".mcap"))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            std::env::temp_dir().join(format!("magsep-sample-{}.mcap", std::process::id()))
-        });
+    let (path, _temp) = sample_target("MAGSEP_WRITE_SAMPLE", "sample.mcap");
     let mut w = RecordingWriter::create(&path, &metadata()).unwrap();
     let edges = DVec3::new(4e-6, 4e-6, 8e-6);
     for step in 0..20u64 {
@@ -522,9 +528,6 @@ fn record_write_sample_for_python_check() {
     let rec = read_recording(&path).unwrap();
     assert_eq!(rec.frames.len(), 20);
     assert!(rec.truncated.is_none());
-    if std::env::var("MAGSEP_WRITE_SAMPLE").is_err() {
-        std::fs::remove_file(&path).ok();
-    }
 }
 
 #[test]

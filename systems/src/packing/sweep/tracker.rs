@@ -136,10 +136,10 @@ impl OverlapTracker {
     /// both at their poses in the state) is certainly at most the tolerance of the last scan
     /// without evaluating it: a scan found room r below the tolerance
     /// ([`crate::packing::state::Above::room`]) when the travels of the two ends summed to T,
-    /// and they have moved since by less than r together. The overlap of two convex bodies changes by no more than how far their
-    /// surface points move (each separating-axis bound h_a(u) + h_b(-u) - d.u along a fixed
-    /// direction u does, and the overlap is their minimum), so it is still below the
-    /// tolerance less the round-off margin.
+    /// and they have moved since by less than r together. The overlap of two convex bodies
+    /// changes by no more than how far their surface points move (each separating-axis bound
+    /// h_a(u) + h_b(-u) - d.u along a fixed direction u does, and the overlap is their
+    /// minimum), so it is still below the tolerance less the round-off margin.
     #[inline]
     pub fn certified(&self, list: &NeighbourList, k: usize, i: usize, j: usize) -> bool {
         if self.built != Some(list.builds) {
