@@ -227,8 +227,14 @@ impl NeighbourList {
     /// than `turn` relative to the centre (a rod: h |du|; any body: bounding radius x angle).
     #[inline]
     pub fn note_move(&mut self, i: usize, dx: DVec3, turn: f64) {
+        self.note_travel(i, dx.length() + turn);
+    }
+
+    /// [`Self::note_move`] with the bound `travel` = |dx| + turn / D already summed.
+    #[inline]
+    pub fn note_travel(&mut self, i: usize, travel: f64) {
         if let Some(m) = self.moved.get_mut(i) {
-            *m += dx.length() + turn;
+            *m += travel;
             if *m > self.max_moved {
                 self.max_moved = *m;
             }

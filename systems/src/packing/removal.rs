@@ -50,7 +50,7 @@ pub fn overlapping_contacts(
     tol: f64,
     out: &mut Vec<MoveContact>,
 ) {
-    let mut warm = Vec::new();
+    let mut warm = super::sweep::WarmChanges::new();
     contacts_of(state, list, None, i, tol, out, &mut warm);
     for (k, w) in warm {
         *list.warm_mut(k as usize) = w;

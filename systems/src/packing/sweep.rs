@@ -60,6 +60,7 @@
 use glam::{DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use smallvec::SmallVec;
 
 use super::moves::{Displacement, MoveContact, MoveRule, overlap_removal_move};
 use super::neighbour::NeighbourList;
@@ -71,23 +72,34 @@ use crate::par::team::Team;
 /// Moves proposed per batch and thread of the parallel sweep.
 pub const BATCH_PER_THREAD: usize = 4;
 
+/// The Newton starts a move changed: (list entry, start). Inline up to four (a move in a dense
+/// packing changes ~2.4), so that proposals are not heap-allocated.
+pub type WarmChanges = SmallVec<[(u32, Option<WarmStart>); 4]>;
+
 /// The move of one particle computed from a fixed state: the Newton starts it changed and its
 /// displacement.
 #[derive(Debug, Clone, Default)]
 pub struct Proposal {
     /// The Newton starts the move changed: (list entry, start).
-    warm: Vec<(u32, Option<WarmStart>)>,
+    warm: WarmChanges,
     displacement: Option<Displacement>,
-    /// How far the rotation moves a surface point ([`turn_bound`]), computed with the move so
-    /// that the serial write-back does not.
-    turn: f64,
+    /// How far the move takes a surface point: the translation's length plus the rotation's
+    /// [`turn_bound`] (0 without a move).
+    travel: f64,
+    /// The orientation after the move (normalised).
+    orientation: DQuat,
 }
 
 impl Proposal {
-    /// Set the displacement of a particle of `body` and its turn bound.
-    fn set_displacement(&mut self, body: &Body, d: Option<Displacement>) {
+    /// Set the displacement of a particle of `body` at orientation `q`, with what the serial
+    /// write-back needs of it computed here (in the parallel part): the travel and the new
+    /// orientation.
+    fn set_displacement(&mut self, body: &Body, q: DQuat, d: Option<Displacement>) {
         self.displacement = d;
-        self.turn = d.map_or(0.0, |d| turn_bound(body, d.rotation));
+        if let Some(d) = d {
+            self.travel = d.dx.length() + turn_bound(body, d.rotation);
+            self.orientation = (d.rotation * q).normalize();
+        }
     }
 }
 
@@ -103,7 +115,7 @@ pub fn contacts_of(
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
-    warm: &mut Vec<(u32, Option<WarmStart>)>,
+    warm: &mut WarmChanges,
 ) {
     contacts_with(state, list, tracker, i, tol, out, warm, |_| None);
 }
@@ -132,7 +144,7 @@ pub fn contacts_with(
     i: usize,
     tol: f64,
     out: &mut Vec<MoveContact>,
-    warm: &mut Vec<(u32, Option<WarmStart>)>,
+    warm: &mut WarmChanges,
     moved: impl Fn(usize) -> Option<(DVec3, DQuat)>,
 ) {
     out.clear();
@@ -189,10 +201,8 @@ pub fn propose(
     let mut p = Proposal::default();
     contacts_of(state, list, tracker, i, tol, scratch, &mut p.warm);
     let body = &state.bodies[i];
-    p.set_displacement(
-        body,
-        overlap_removal_move(rule, body, state.orientations[i], scratch, rng),
-    );
+    let q = state.orientations[i];
+    p.set_displacement(body, q, overlap_removal_move(rule, body, q, scratch, rng));
     p
 }
 
@@ -206,8 +216,8 @@ pub fn commit(state: &mut PackingState, list: &mut NeighbourList, i: usize, p: &
         return false;
     };
     state.positions[i] += d.dx;
-    state.orientations[i] = (d.rotation * state.orientations[i]).normalize();
-    list.note_move(i, d.dx, p.turn);
+    state.orientations[i] = p.orientation;
+    list.note_travel(i, p.travel);
     true
 }
 
@@ -226,8 +236,7 @@ pub(crate) fn commit_counted(
     if moved {
         *attempts += 1;
         count.moves += 1;
-        let travel = p.displacement.map_or(0.0, |d| d.dx.length() + p.turn);
-        tracker.note_moved(i, travel);
+        tracker.note_moved(i, p.travel);
     }
     moved
 }

@@ -132,36 +132,29 @@ impl SweepCells {
     /// The sweep's queues: per colour (in order), per cell of it (in index order), the
     /// particles of `order` in that cell, in `order`'s order.
     pub fn queues(&self, state: &PackingState, order: &[usize]) -> Vec<Vec<Vec<usize>>> {
-        // the position in `order` makes every key distinct: an unstable sort keeps `order`'s
-        // order within a cell
-        let mut keyed: Vec<(u32, u32, u32, usize)> = order
+        // a counting sort by cell (one pass to count, one to place, in `order`'s order)
+        let ncells = self.n.iter().product::<usize>();
+        let located: Vec<(u32, u32)> = order
             .iter()
-            .enumerate()
-            .map(|(q, &i)| {
-                let (colour, cell) = self.locate(state.positions[i]);
-                (colour, cell, q as u32, i)
-            })
+            .map(|&i| self.locate(state.positions[i]))
             .collect();
-        keyed.sort_unstable_by_key(|&(colour, cell, q, _)| (colour, cell, q));
+        let mut cells: Vec<Vec<usize>> = vec![Vec::new(); ncells];
+        let mut colour_of = vec![0u32; ncells];
+        for (&i, &(colour, cell)) in order.iter().zip(&located) {
+            cells[cell as usize].push(i);
+            colour_of[cell as usize] = colour;
+        }
         let mut out: Vec<Vec<Vec<usize>>> = Vec::new();
-        let mut colour_cells: Vec<Vec<usize>> = Vec::new();
-        let mut queue: Vec<usize> = Vec::new();
-        let mut last: Option<(u32, u32)> = None;
-        for (colour, cell, _, i) in keyed {
-            if let Some((c, k)) = last {
-                if (c, k) != (colour, cell) {
-                    colour_cells.push(std::mem::take(&mut queue));
-                }
-                if c != colour {
-                    out.push(std::mem::take(&mut colour_cells));
+        for colour in 0..8 {
+            let mut queues: Vec<Vec<usize>> = Vec::new();
+            for (queue, &c) in cells.iter_mut().zip(&colour_of) {
+                if c == colour && !queue.is_empty() {
+                    queues.push(std::mem::take(queue));
                 }
             }
-            last = Some((colour, cell));
-            queue.push(i);
-        }
-        if !queue.is_empty() {
-            colour_cells.push(queue);
-            out.push(colour_cells);
+            if !queues.is_empty() {
+                out.push(queues);
+            }
         }
         out
     }
@@ -340,11 +333,12 @@ fn run_cell(
         let body = &state.bodies[i];
         p.set_displacement(
             body,
+            o,
             overlap_removal_move(rule, body, o, &scratch, &mut no_rng),
         );
         let past_skin = p.displacement.is_some_and(|d| {
-            poses[q - start] = Some((x + d.dx, (d.rotation * o).normalize()));
-            list.exceeds_skin(list.moved_of(i) + (d.dx.length() + p.turn))
+            poses[q - start] = Some((x + d.dx, p.orientation));
+            list.exceeds_skin(list.moved_of(i) + p.travel)
         });
         moves.push((i, p));
         if past_skin {

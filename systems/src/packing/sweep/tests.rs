@@ -335,7 +335,7 @@ fn certified_pairs_stay_below_the_tolerance_as_their_ends_move() {
                 rotation: DQuat::from_scaled_axis(r(0.06)),
             };
             let mut p = Proposal::default();
-            p.set_displacement(&state.bodies[i], Some(d));
+            p.set_displacement(&state.bodies[i], state.orientations[i], Some(d));
             commit_counted(
                 &mut state,
                 &mut list,
