@@ -86,7 +86,7 @@ pub struct Proposal {
     /// How far the move takes a surface point: the translation's length plus the rotation's
     /// [`turn_bound`] (0 without a move).
     travel: f64,
-    /// The orientation after the move (normalised).
+    /// The orientation after the move (normalised; the present one without a move).
     orientation: DQuat,
 }
 
@@ -96,10 +96,8 @@ impl Proposal {
     /// orientation.
     fn set_displacement(&mut self, body: &Body, q: DQuat, d: Option<Displacement>) {
         self.displacement = d;
-        if let Some(d) = d {
-            self.travel = d.dx.length() + turn_bound(body, d.rotation);
-            self.orientation = (d.rotation * q).normalize();
-        }
+        self.travel = d.map_or(0.0, |d| d.dx.length() + turn_bound(body, d.rotation));
+        self.orientation = d.map_or(q, |d| (d.rotation * q).normalize());
     }
 }
 

@@ -132,7 +132,8 @@ impl SweepCells {
     /// The sweep's queues: per colour (in order), per cell of it (in index order), the
     /// particles of `order` in that cell, in `order`'s order.
     pub fn queues(&self, state: &PackingState, order: &[usize]) -> Vec<Vec<Vec<usize>>> {
-        // a counting sort by cell (one pass to count, one to place, in `order`'s order)
+        // bucketed by cell in one pass over `order` (so in its order within a cell), then the
+        // cells of each colour in index order
         let ncells = self.n.iter().product::<usize>();
         let located: Vec<(u32, u32)> = order
             .iter()
