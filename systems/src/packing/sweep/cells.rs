@@ -133,30 +133,22 @@ impl SweepCells {
     /// particles of `order` in that cell, in `order`'s order.
     pub fn queues(&self, state: &PackingState, order: &[usize]) -> Vec<Vec<Vec<usize>>> {
         // bucketed by cell in one pass over `order` (so in its order within a cell), then the
-        // cells of each colour in index order
+        // non-empty cells of each colour in index order
         let ncells = self.n.iter().product::<usize>();
-        let located: Vec<(u32, u32)> = order
-            .iter()
-            .map(|&i| self.locate(state.positions[i]))
-            .collect();
-        let mut cells: Vec<Vec<usize>> = vec![Vec::new(); ncells];
-        let mut colour_of = vec![0u32; ncells];
-        for (&i, &(colour, cell)) in order.iter().zip(&located) {
-            cells[cell as usize].push(i);
-            colour_of[cell as usize] = colour;
+        let mut cells: Vec<(u32, Vec<usize>)> = vec![(0, Vec::new()); ncells];
+        for &i in order {
+            let (colour, cell) = self.locate(state.positions[i]);
+            let bucket = &mut cells[cell as usize];
+            bucket.0 = colour;
+            bucket.1.push(i);
         }
-        let mut out: Vec<Vec<Vec<usize>>> = Vec::new();
-        for colour in 0..8 {
-            let mut queues: Vec<Vec<usize>> = Vec::new();
-            for (queue, &c) in cells.iter_mut().zip(&colour_of) {
-                if c == colour && !queue.is_empty() {
-                    queues.push(std::mem::take(queue));
-                }
-            }
-            if !queues.is_empty() {
-                out.push(queues);
+        let mut out: Vec<Vec<Vec<usize>>> = vec![Vec::new(); 8];
+        for (colour, queue) in cells {
+            if !queue.is_empty() {
+                out[colour as usize].push(queue);
             }
         }
+        out.retain(|queues| !queues.is_empty());
         out
     }
 }
