@@ -112,18 +112,20 @@ pub fn overlap_scan(
     scan
 }
 
-/// How far a rotation `r` can move a surface point of `body` relative to its centre / D.
+/// How far a rotation `r` (a unit quaternion) can move a surface point of `body` relative to
+/// its centre / D: the chord 2 R sin(theta/2) of the reach R, with sin(theta/2) the length of
+/// the quaternion's vector part (no inverse cosine and sine on the move's path).
 #[inline]
 pub fn turn_bound(body: &Body, r: DQuat) -> f64 {
     if !body.rotates() {
         return 0.0;
     }
-    let angle = 2.0 * r.w.abs().min(1.0).acos();
+    let half_sin = r.xyz().length().min(1.0);
     let reach = match body.kind {
         BodyKind::Rod => body.half_length,
         BodyKind::Superquadric(_) => body.bounding_radius(),
     };
-    reach * 2.0 * (0.5 * angle).sin()
+    reach * 2.0 * half_sin
 }
 
 /// Move particle `i` once with `rule` if it overlaps anything above `tol`. Returns whether it

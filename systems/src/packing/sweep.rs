@@ -129,10 +129,11 @@ fn same_bits(a: &Option<WarmStart>, b: &Option<WarmStart>) -> bool {
     }
 }
 
-/// [`contacts_of`] where `moved(j)` gives the pose (centre, orientation) of a neighbour `j`
-/// that has moved since the state was written (a cell sweep's moves before their write-back),
-/// None for the state's own pose. A moved neighbour's pair is solved anew (not taken from the
-/// tracker's cache).
+/// [`contacts_of`] where `moved(j)` gives the pose (centre, orientation) and the travel of a
+/// neighbour `j` that has moved since the state was written (a cell sweep's moves before their
+/// write-back), None for the state's own pose. A moved neighbour's pair is not taken from the
+/// tracker's cache; it is skipped when the tracker certifies it with that travel counted, as
+/// the serial order would after the write-back, and otherwise solved anew.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn contacts_with(
@@ -143,7 +144,7 @@ pub fn contacts_with(
     tol: f64,
     out: &mut Vec<MoveContact>,
     warm: &mut WarmChanges,
-    moved: impl Fn(usize) -> Option<(DVec3, DQuat)>,
+    moved: impl Fn(usize) -> Option<((DVec3, DQuat), f64)>,
 ) {
     out.clear();
     warm.clear();
@@ -154,7 +155,10 @@ pub fn contacts_with(
         let j = nb.j as usize;
         let old = list.warm(k);
         let mut w = old;
-        let c = if let Some((xj, qj)) = moved(j) {
+        let c = if let Some(((xj, qj), pending)) = moved(j) {
+            if tracker.is_some_and(|t| t.certified_after(list, k, i, j, pending)) {
+                continue;
+            }
             let pose_j = (xj + nb.shift(state.edges), qj);
             state.contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
         } else {

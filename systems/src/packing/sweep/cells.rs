@@ -298,7 +298,8 @@ fn run_cell(
     rule: MoveRule,
     tol: f64,
 ) -> CellRun {
-    let mut poses: Vec<Option<(DVec3, DQuat)>> = vec![None; queue.len() - start];
+    // the poses and travels of the cell's moves so far
+    let mut poses: Vec<Option<((DVec3, DQuat), f64)>> = vec![None; queue.len() - start];
     let mut moves = Vec::with_capacity(queue.len() - start);
     let mut scratch = Vec::new();
     // the rules that run here draw no random numbers: this stream is never read
@@ -330,7 +331,7 @@ fn run_cell(
             overlap_removal_move(rule, body, o, &scratch, &mut no_rng),
         );
         let past_skin = p.displacement.is_some_and(|d| {
-            poses[q - start] = Some((x + d.dx, p.orientation));
+            poses[q - start] = Some(((x + d.dx, p.orientation), p.travel));
             list.exceeds_skin(list.moved_of(i) + p.travel)
         });
         moves.push((i, p));

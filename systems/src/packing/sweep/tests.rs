@@ -363,3 +363,34 @@ fn certified_pairs_stay_below_the_tolerance_as_their_ends_move() {
         "{checked} checked, {lost} lost"
     );
 }
+
+/// The turn bound is the chord 2 R sin(theta/2) that a rotation by theta moves a point at the
+/// reach R, from tiny turns to half turns, and it bounds how far surface points move.
+#[test]
+fn turn_bound_is_the_chord_of_the_rotation() {
+    use crate::packing::removal::turn_bound;
+    use glam::DQuat;
+    use rand::RngExt;
+    let body = Body::from_shape(&SUPERBALL, 1.0);
+    let reach = body.bounding_radius();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+    for n in 0..2000 {
+        let axis = DVec3::new(
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+        )
+        .normalize();
+        let angle = if n % 2 == 0 {
+            std::f64::consts::PI * rng.random::<f64>()
+        } else {
+            1e-4 * rng.random::<f64>()
+        };
+        let q = DQuat::from_axis_angle(axis, angle);
+        let chord = 2.0 * reach * (0.5 * angle).sin();
+        let bound = turn_bound(&body, q);
+        assert!((bound - chord).abs() <= 1e-14 + 1e-12 * chord, "{angle}: {bound} {chord}");
+        let p = axis.any_orthonormal_vector() * reach;
+        assert!((q * p - p).length() <= bound * (1.0 + 1e-12) + 1e-15);
+    }
+}

@@ -142,12 +142,27 @@ impl OverlapTracker {
     /// minimum), so it is still below the tolerance less the round-off margin.
     #[inline]
     pub fn certified(&self, list: &NeighbourList, k: usize, i: usize, j: usize) -> bool {
+        self.certified_after(list, k, i, j, 0.0)
+    }
+
+    /// [`Self::certified`] as it will be once `j` has made a pending move of travel
+    /// `pending` (a cell sweep's move before its write-back; the sum is rounded as
+    /// [`Self::note_moved`] will round it, so the answer is the one after the write-back).
+    #[inline]
+    pub fn certified_after(
+        &self,
+        list: &NeighbourList,
+        k: usize,
+        i: usize,
+        j: usize,
+        pending: f64,
+    ) -> bool {
         if self.built != Some(list.builds) {
             return false;
         }
         let clear = self.clear.get(list.pair_of_entry(k)).copied();
         let t = |p: usize| self.travel.get(p).copied().unwrap_or(f64::INFINITY);
-        clear.is_some_and(|c| t(i) + t(j) < c)
+        clear.is_some_and(|c| t(i) + (t(j) + pending) < c)
     }
 
     /// Set `flags[i]` for every particle with a pair or wall overlap above `tol`, evaluating
