@@ -20,7 +20,8 @@
 //! cells with the most particles left are started first (the results are kept in cell order).
 //!
 //! **Runs.** A cell's moves are computed against the state at the start of the run, with the
-//! poses of the cell's own earlier moves laid over it ([`super::contacts_with`]), and written
+//! poses of the cell's own earlier moves laid over it ([`super::contacts_with`]; the tracker's
+//! certificates count those moves' travels, as they will after the write-back), and written
 //! back (Newton starts, poses, the list's displacement bounds, the tracker's versions) cell by
 //! cell in the serial order after the run. A cell stops after the move that takes its particle
 //! past the list's skin (the move the serial sweep would make just before a rebuild); the
