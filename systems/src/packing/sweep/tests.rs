@@ -389,7 +389,10 @@ fn turn_bound_is_the_chord_of_the_rotation() {
         let q = DQuat::from_axis_angle(axis, angle);
         let chord = 2.0 * reach * (0.5 * angle).sin();
         let bound = turn_bound(&body, q);
-        assert!((bound - chord).abs() <= 1e-14 + 1e-12 * chord, "{angle}: {bound} {chord}");
+        assert!(
+            (bound - chord).abs() <= 1e-14 + 1e-12 * chord,
+            "{angle}: {bound} {chord}"
+        );
         let p = axis.any_orthonormal_vector() * reach;
         assert!((q * p - p).length() <= bound * (1.0 + 1e-12) + 1e-15);
     }
