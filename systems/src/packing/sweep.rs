@@ -155,27 +155,27 @@ pub fn contacts_with(
         let j = nb.j as usize;
         let old = list.warm(k);
         let mut w = old;
-        let c = if let Some(((xj, qj), pending)) = moved(j) {
-            if tracker.is_some_and(|t| t.certified_after(list, k, i, j, pending)) {
-                continue;
-            }
-            let pose_j = (xj + nb.shift(state.edges), qj);
-            state.contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
-        } else {
-            if let Some(t) = tracker {
-                if let Some(c) = t.cached(list, k, i, j) {
+        // a moved neighbour's pose and pending travel, else its pose in the state, whose
+        // pair the tracker may have cached since neither end moved
+        let ((xj, qj), pending) = match moved(j) {
+            Some(m) => m,
+            None => {
+                if let Some(c) = tracker.and_then(|t| t.cached(list, k, i, j)) {
                     if let Some(c) = c.filter(|c| c.overlap > tol) {
                         out.push(c);
                     }
                     continue;
                 }
-                if t.certified(list, k, i, j) {
-                    continue;
-                }
+                ((state.positions[j], state.orientations[j]), 0.0)
             }
-            state.contact_warm_above(i, j, nb.shift(state.edges), &mut w, tol)
+        };
+        if tracker.is_some_and(|t| t.certified_after(list, k, i, j, pending)) {
+            continue;
         }
-        .contact;
+        let pose_j = (xj + nb.shift(state.edges), qj);
+        let c = state
+            .contact_warm_above_at(i, pose_i, j, pose_j, &mut w, tol)
+            .contact;
         if !same_bits(&w, &old) {
             warm.push((k as u32, w));
         }
