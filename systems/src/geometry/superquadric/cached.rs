@@ -202,13 +202,17 @@ pub fn overlap_upper_bound(
         return outer - dist;
     }
     let (qa, qb) = (qa.normalize(), qb.normalize());
+    // u in a's body frame and in the lab: from the warm point the body-frame normal needs no
+    // rotation there and back
     let from_warm = warm
         .filter(|w| w.s_a.is_finite())
-        .and_then(|w| (qa * a.prepared.eval(w.s_a).grad).try_normalize());
-    let Some(u) = from_warm.or_else(|| d.try_normalize()) else {
+        .and_then(|w| a.prepared.eval(w.s_a).grad.try_normalize())
+        .map(|ua| (ua, qa * ua));
+    let Some((ua, u)) = from_warm.or_else(|| d.try_normalize().map(|u| (qa.conjugate() * u, u)))
+    else {
         return f64::INFINITY;
     };
-    let (ua, ub) = (qa.conjugate() * u, qb.conjugate() * -u);
+    let ub = qb.conjugate() * -u;
     let bound = a.prepared.support_value(ua) + b.prepared.support_value(ub) - d.dot(u);
     if bound.is_nan() { f64::INFINITY } else { bound }
 }
