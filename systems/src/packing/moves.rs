@@ -125,10 +125,9 @@ pub fn revised_velocities(
         t += c.normal.cross(c.rc);
     }
     let m = body.volume;
+    // I^-1 t = R (I_body^-1 (R^T t)): two matrix-vector products, not the matrix R I^-1 R^T
     let rot = DMat3::from_quat(orientation);
-    let inv_body = DMat3::from_diagonal(body.inertia.recip());
-    let iinv = rot * inv_body * rot.transpose();
-    let it = iinv * t;
+    let it = rot * (body.inertia.recip() * (rot.transpose() * t));
     let lambda = ((f.dot(f) / m + t.dot(it)) / 2.0).sqrt();
     if lambda.is_nan() || lambda <= 1e-300 {
         return None;
