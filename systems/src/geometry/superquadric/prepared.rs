@@ -189,7 +189,8 @@ impl Prepared {
 
     /// The support function h(w) = max over the body of w . x (body frame), for bounds: equal
     /// to `w.dot(self.support(w))` up to a relative 1e-15 or so (for equal exponents of 3 the
-    /// cube root is a polynomial start and two Halley steps instead of `cbrt`).
+    /// cube root is a polynomial start and Halley steps instead of `cbrt`: one step for unit
+    /// directions and equal semi-axes, where its argument lies in a narrow interval, else two).
     #[inline]
     pub fn support_value(&self, w: DVec3) -> f64 {
         if !(self.equal && self.inv_g == Root::Third) {
