@@ -273,7 +273,12 @@ pub(crate) fn cube_root_narrow(s: f64) -> f64 {
         0.041_994_133_801_533_35,
     ];
     let t = s - 1.0;
-    let y = C[0] + t * (C[1] + t * (C[2] + t * C[3]));
+    halley_cube_root_step(C[0] + t * (C[1] + t * (C[2] + t * C[3])), s)
+}
+
+/// One Halley step for y = cbrt(s): y (y^3 + 2s) / (2y^3 + s), which cubes the relative error.
+#[inline(always)]
+fn halley_cube_root_step(y: f64, s: f64) -> f64 {
     let y3 = y * y * y;
     y * ((y3 + 2.0 * s) / (2.0 * y3 + s))
 }
@@ -291,8 +296,7 @@ pub(crate) fn cube_root_1_3(s: f64) -> f64 {
     let q = 0.5 * (C3 - 1.0) - b; // the second divided difference
     let mut y = 1.0 + t * (b + (t - 1.0) * q);
     for _ in 0..2 {
-        let y3 = y * y * y;
-        y *= (y3 + 2.0 * s) / (2.0 * y3 + s);
+        y = halley_cube_root_step(y, s);
     }
     y
 }
