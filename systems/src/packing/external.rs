@@ -29,7 +29,7 @@ pub struct PackingKernels<'a> {
     pub kernels: &'a ExternalForces,
     /// Reference diameter D \[m\].
     pub d: f64,
-    /// SI shapes in `ParticleId` order.
+    /// SI shapes in dense order.
     pub shapes: &'a [Shape],
     /// `ParticleId`s in dense order.
     pub ids: &'a [u64],

@@ -16,6 +16,17 @@
 //! every task is done and no helper still looks at the phase. Which thread runs which task
 //! does not change any result: tasks write only their own slot.
 //!
+//! **Sided phases** ([`Team::map_sided`]). Two processors share data through their caches: a
+//! line one of them wrote must travel to the other before it can read it. Profiled on the
+//! 750-superball scene, the tasks of the sweeps and scans did ~1.4x the work of the one-thread
+//! run when every thread claimed the next task from one counter, all of it in the code that
+//! loads poses, Newton starts and cached contacts (the arithmetic of the contact solves took
+//! the same time). In a sided phase the leader claims tasks from the front and the helpers
+//! from the back; callers order the tasks by place (the packing's particles are numbered
+//! along a space-filling curve, `crate::packing::systems::spatial_order`), so that a
+//! particle's data stays with one processor from phase to phase while the load still
+//! balances where the two ends meet.
+//!
 //! Helpers are OS threads of a [`std::thread::scope`] (one fewer than rayon's current
 //! thread count), not rayon jobs, so the leader may still use rayon inside the team's scope
 //! (rayon's idle threads help it as usual) without ever running a helper's wait loop itself.
@@ -39,8 +50,37 @@ const NAP: Duration = Duration::from_micros(100);
 struct Phase<'a> {
     f: &'a (dyn Fn(usize) + Sync),
     n: usize,
-    next: AtomicUsize,
+    /// Tasks claimed from the front (low 32 bits) and from the back (high 32 bits).
+    claims: AtomicU64,
+    /// Whether helpers claim from the back (the leader always claims from the front).
+    sided: bool,
     done: AtomicUsize,
+}
+
+impl Phase<'_> {
+    /// Claim the next task from the front or the back; None when every task is claimed.
+    #[inline]
+    fn claim(&self, back: bool) -> Option<usize> {
+        let mut cur = self.claims.load(Ordering::Relaxed);
+        loop {
+            let (f, b) = ((cur & 0xffff_ffff) as usize, (cur >> 32) as usize);
+            if f + b >= self.n {
+                return None;
+            }
+            let (next, i) = if back {
+                (cur + (1 << 32), self.n - 1 - b)
+            } else {
+                (cur + 1, f)
+            };
+            match self
+                .claims
+                .compare_exchange_weak(cur, next, Ordering::Relaxed, Ordering::Relaxed)
+            {
+                Ok(_) => return Some(i),
+                Err(now) => cur = now,
+            }
+        }
+    }
 }
 
 /// What the leader and the helpers share.
@@ -60,12 +100,9 @@ struct Shared {
 
 impl Shared {
     /// Claim and run tasks of `phase` until none is left.
-    fn work(&self, phase: &Phase<'_>) {
-        loop {
-            let i = phase.next.fetch_add(1, Ordering::Relaxed);
-            if i >= phase.n {
-                return;
-            }
+    fn work(&self, phase: &Phase<'_>, helper: bool) {
+        let back = helper && phase.sided;
+        while let Some(i) = phase.claim(back) {
             if let Err(p) = catch_unwind(AssertUnwindSafe(|| (phase.f)(i))) {
                 let mut slot = self.panic.lock().unwrap_or_else(|e| e.into_inner());
                 slot.get_or_insert(p);
@@ -102,7 +139,7 @@ impl Shared {
                 // SAFETY: the leader nulls `phase` and then waits for `active` to drop to
                 // zero before the phase goes out of scope; we raised `active` before
                 // loading the pointer (both SeqCst), so the phase is alive until we lower it.
-                self.work(unsafe { &*p });
+                self.work(unsafe { &*p }, true);
             }
             self.active.fetch_sub(1, Ordering::SeqCst);
             idle = Instant::now();
@@ -160,6 +197,17 @@ impl Team<'_> {
     /// leader (the thread that runs [`Team::scope`]'s closure) calls it, and never from
     /// inside a task (a team runs one phase at a time).
     pub fn map<R: Send>(&self, n: usize, f: impl Fn(usize) -> R + Sync) -> Vec<R> {
+        self.map_with(n, false, f)
+    }
+
+    /// [`Team::map`] where the leader claims tasks from the front and the helpers from the
+    /// back: tasks ordered by place (the leader's region first) keep each region's data in
+    /// one processor's cache from phase to phase.
+    pub fn map_sided<R: Send>(&self, n: usize, f: impl Fn(usize) -> R + Sync) -> Vec<R> {
+        self.map_with(n, true, f)
+    }
+
+    fn map_with<R: Send>(&self, n: usize, sided: bool, f: impl Fn(usize) -> R + Sync) -> Vec<R> {
         if self.threads == 1 || n <= 1 {
             return (0..n).map(f).collect();
         }
@@ -171,7 +219,8 @@ impl Team<'_> {
         let phase = Phase {
             f: &task,
             n,
-            next: AtomicUsize::new(0),
+            claims: AtomicU64::new(0),
+            sided,
             done: AtomicUsize::new(0),
         };
         let sh = self.shared;
@@ -180,7 +229,7 @@ impl Team<'_> {
         let erased = &phase as *const Phase<'_> as *mut Phase<'static>;
         sh.phase.store(erased, Ordering::SeqCst);
         sh.epoch.fetch_add(1, Ordering::SeqCst);
-        sh.work(&phase);
+        sh.work(&phase, false);
         while phase.done.load(Ordering::Acquire) < n {
             std::hint::spin_loop();
         }
@@ -261,7 +310,8 @@ mod tests {
             .unwrap()
     }
 
-    /// Many short phases in a row give every task's result in order, on 1-3 threads.
+    /// Many short phases in a row, plain and sided, give every task's result in order, on 1-3
+    /// threads.
     #[test]
     fn phases_return_every_result_in_order() {
         for threads in 1..=3 {
@@ -269,7 +319,16 @@ mod tests {
                 Team::scope(|team| {
                     assert_eq!(team.threads(), threads);
                     (0..2000)
-                        .map(|k| team.map(k % 7, |i| i * 1000 + k).iter().sum::<usize>())
+                        .map(|k| {
+                            let f = |i| i * 1000 + k;
+                            let r = if k % 2 == 0 {
+                                team.map(k % 7, f)
+                            } else {
+                                team.map_sided(k % 7, f)
+                            };
+                            assert_eq!(r, (0..k % 7).map(f).collect::<Vec<_>>());
+                            r.iter().sum::<usize>()
+                        })
                         .collect::<Vec<_>>()
                 })
             });

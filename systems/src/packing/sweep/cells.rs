@@ -17,7 +17,9 @@
 //! list's present reach (a rebuild within the sweep may lengthen it), no listed pair can join
 //! them. Otherwise it is checked on the list itself before each run; if a listed pair does
 //! join two such cells, the colour's cells run one after the other instead. Within a run the
-//! cells with the most particles left are started first (the results are kept in cell order).
+//! leader takes cells from the first and the helpers from the last (`Team::map_sided`): the
+//! particles' dense order follows the cells' numbering, so each processor keeps the data of
+//! its part of the box in its cache from phase to phase.
 //!
 //! **Runs.** A cell's moves are computed against the state at the start of the run, with the
 //! poses of the cell's own earlier moves laid over it ([`super::contacts_with`]; the tracker's
@@ -216,18 +218,10 @@ pub fn sweep_cells(
                 let (s, l, t, m) = (&*state, &*list, &*tracker, &marks);
                 let run =
                     |&c: &usize| run_cell(s, l, t, &queues[c], pos[c], c as u32, m, rule, tol);
-                // the longest queues first, so that no thread is left with a long cell at
-                // the end of the phase; the results are kept in cell order
-                let mut longest: Vec<usize> = (0..g.len()).collect();
-                longest.sort_by_key(|&x| std::cmp::Reverse(queues[g[x]].len() - pos[g[x]]));
-                let mut results: Vec<Option<CellRun>> = (0..g.len()).map(|_| None).collect();
-                for (x, r) in longest
-                    .iter()
-                    .zip(team.map(g.len(), |y| run(&g[longest[y]])))
-                {
-                    results[*x] = Some(r);
-                }
-                let results = results.into_iter().flatten();
+                // in cell order, the leader from the first cell and the helpers from the last
+                // (cells are numbered along the axes the particles' dense order follows, so
+                // each processor keeps its part of the box: see `Team::map_sided`)
+                let results = team.map_sided(g.len(), |y| run(&g[y]));
                 let mut stopped = false;
                 for (&c, r) in g.iter().zip(results) {
                     for (i, p) in &r.moves {

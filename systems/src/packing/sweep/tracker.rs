@@ -263,7 +263,9 @@ impl OverlapTracker {
         let overlap = Scatter::new(&mut self.overlap);
         let cache = Scatter::new(&mut self.cache);
         let clear = Scatter::new(&mut self.clear);
-        let chunks = team.map(selected.len().div_ceil(SCAN_CHUNK), |c| {
+        // sided: the pairs are in the order of their particles, which is spatial (see
+        // `crate::packing::systems::spatial_order`), so each processor keeps its half
+        let chunks = team.map_sided(selected.len().div_ceil(SCAN_CHUNK), |c| {
             let end = ((c + 1) * SCAN_CHUNK).min(selected.len());
             let mut out = ScanChunk::default();
             for &p in &selected[c * SCAN_CHUNK..end] {
