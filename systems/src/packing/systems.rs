@@ -360,15 +360,10 @@ mod tests {
     /// high half and neighbouring particles next to each other; ties and NaN do not panic.
     #[test]
     fn spatial_order_is_a_permutation_along_a_z_curve() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{RngExt, SeedableRng};
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(12345);
         let positions: Vec<DVec3> = (0..1000)
-            .map(|_| DVec3::new(next(), next(), next()) * 10.0)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 10.0)
             .collect();
         let order = spatial_order(&positions);
         let mut seen = order.clone();
