@@ -208,7 +208,9 @@ impl Team<'_> {
     }
 
     fn map_with<R: Send>(&self, n: usize, sided: bool, f: impl Fn(usize) -> R + Sync) -> Vec<R> {
-        if self.threads == 1 || n <= 1 {
+        // (more tasks than the 32-bit claim counters hold: no phase of the packing comes
+        // near, but such a map still runs, on the leader alone)
+        if self.threads == 1 || n <= 1 || n > u32::MAX as usize {
             return (0..n).map(f).collect();
         }
         let slots: Vec<Mutex<Option<R>>> = (0..n).map(|_| Mutex::new(None)).collect();
