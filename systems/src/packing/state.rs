@@ -21,7 +21,8 @@ use super::walls::{self, WallContact, WallKind};
 use crate::geometry::superquadric::{WarmStart, contact_prepared_within, overlap_upper_bound};
 
 /// Round-off margin / D of [`PackingState::contact_warm_above`]'s bound test (the bound's own
-/// error is ~1e-15 D, the solver's ~1e-13 D).
+/// error is ~1e-15 D; the solver's, at the packing's Newton tolerance of 1e-10, is below
+/// ~5e-11 D: [`super::contact::solver_options`]).
 const BOUND_MARGIN: f64 = 1e-10;
 
 /// What [`PackingState::contact_warm_above`] found for a pair.
@@ -187,7 +188,7 @@ impl PackingState {
     /// superquadric pair whose overlap is certainly at most `tol` (its separating-axis bound
     /// along the cached contact normal, [`overlap_upper_bound`], below `tol` less a round-off
     /// margin) is not solved and keeps its cached Newton start: its solved overlap would be
-    /// below `tol` too (to the solver's accuracy, ~1e-13 D, far inside the margin).
+    /// below `tol` too (to the solver's accuracy, ~5e-11 D at most, inside the margin).
     #[inline]
     pub fn contact_warm_above(
         &self,
