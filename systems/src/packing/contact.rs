@@ -227,7 +227,7 @@ mod tests {
     #[test]
     fn the_packing_tolerance_keeps_contacts_within_the_bound_margin() {
         let mut r = Xoshiro256PlusPlus::seed_from_u64(17);
-        let mut unit = |r: &mut Xoshiro256PlusPlus| loop {
+        let unit = |r: &mut Xoshiro256PlusPlus| loop {
             let v = DVec3::new(r.random(), r.random(), r.random()) * 2.0 - 1.0;
             if (0.01..1.0).contains(&v.length_squared()) {
                 return v.normalize();
