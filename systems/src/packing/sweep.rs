@@ -11,8 +11,8 @@
 //! the first (full) scan only the pairs with a moved end are evaluated again; the others keep
 //! their overlap. This is exact up to the contact solver's own accuracy (~5e-11 D at most):
 //! the serial code it replaces re-solved every pair from its cached solution, which returns
-//! the same overlap to that accuracy. The first scan, and every scan after a list rebuild (the rebuild
-//! wraps the centres and renumbers the pairs), is full.
+//! the same overlap to that accuracy. The first scan, and every scan after a list rebuild
+//! (the rebuild wraps the centres and renumbers the pairs), is full.
 //!
 //! **Contact cache.** The scan keeps each superquadric pair's contact for both directed
 //! entries (the other direction by symmetry: the same overlap, the normal reversed, the contact
@@ -22,8 +22,8 @@
 //! of them finds the pair as scanned, so each such pair costs two solves per sweep instead of
 //! three. The contact is the one of the present poses either way; a new warm-started solve
 //! differs only at the solver's accuracy (~5e-11 D at most), so the packing is not the old
-//! one bit for bit, but it is still the same for any thread count (the cache is written only by the scan,
-//! between sweeps). Rod pairs (closed-form contacts) are not cached. Moves and scans need only
+//! one bit for bit, but it is still the same for any thread count (the cache is written only
+//! by the scan, between sweeps). Rod pairs (closed-form contacts) are not cached. Moves and scans need only
 //! the contacts above the tolerance, so a superquadric pair whose separating-axis bound along
 //! its last contact normal is below it is not solved at all
 //! ([`PackingState::contact_warm_above`]; the cache records it as such): in the dense regime
