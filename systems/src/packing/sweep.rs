@@ -23,9 +23,9 @@
 //! three. The contact is the one of the present poses either way; a new warm-started solve
 //! differs only at the solver's accuracy (~5e-11 D at most), so the packing is not the old
 //! one bit for bit, but it is still the same for any thread count (the cache is written only
-//! by the scan, between sweeps). Rod pairs (closed-form contacts) are not cached. Moves and scans need only
-//! the contacts above the tolerance, so a superquadric pair whose separating-axis bound along
-//! its last contact normal is below it is not solved at all
+//! by the scan, between sweeps). Rod pairs (closed-form contacts) are not cached. Moves and
+//! scans need only the contacts above the tolerance, so a superquadric pair whose
+//! separating-axis bound along its last contact normal is below it is not solved at all
 //! ([`PackingState::contact_warm_above`]; the cache records it as such): in the dense regime
 //! about three quarters of the pair evaluations end there.
 //!
