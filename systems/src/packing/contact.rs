@@ -212,10 +212,10 @@ pub(crate) fn from_solver(
 #[cfg(test)]
 mod tests {
     use glam::{DQuat, DVec3};
-    use rand::{RngExt, SeedableRng};
-    use rand_xoshiro::Xoshiro256PlusPlus;
+    use rand::RngExt;
 
     use super::solver_options;
+    use crate::geometry::superquadric::tests::{quat, rng, unit};
     use crate::geometry::superquadric::{
         ContactOptions, ContactStatus, PreparedShape, Superquadric, contact_prepared,
     };
@@ -227,13 +227,7 @@ mod tests {
     /// which the iteration count does not show.)
     #[test]
     fn the_packing_tolerance_keeps_contacts_within_the_bound_margin() {
-        let mut r = Xoshiro256PlusPlus::seed_from_u64(17);
-        let unit = |r: &mut Xoshiro256PlusPlus| loop {
-            let v = DVec3::new(r.random(), r.random(), r.random()) * 2.0 - 1.0;
-            if (0.01..1.0).contains(&v.length_squared()) {
-                return v.normalize();
-            }
-        };
+        let mut r = rng(17);
         let tight = ContactOptions {
             tolerance: 1e-12,
             ..solver_options()
@@ -242,8 +236,7 @@ mod tests {
         for case in 0..400 {
             let s = Superquadric::superball(0.5, 2.5 + 2.0 * (case % 5) as f64 / 4.0);
             let p = PreparedShape::new(&s);
-            let qa = DQuat::from_scaled_axis(unit(&mut r) * r.random_range(0.0..3.0));
-            let qb = DQuat::from_scaled_axis(unit(&mut r) * r.random_range(0.0..3.0));
+            let (qa, qb) = (quat(&mut r), quat(&mut r));
             let u = unit(&mut r);
             let reach = s.support_value(qa.conjugate() * u) + s.support_value(qb.conjugate() * -u);
             let xb = u * (reach - 1e-4);

@@ -77,7 +77,7 @@ mod seed;
 mod shape;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 #[cfg(test)]
 mod tests_cached;
 #[cfg(test)]

@@ -10,11 +10,11 @@ use glam::{DMat3, DQuat, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-pub(super) fn rng(seed: u64) -> Xoshiro256PlusPlus {
+pub(crate) fn rng(seed: u64) -> Xoshiro256PlusPlus {
     Xoshiro256PlusPlus::seed_from_u64(seed)
 }
 
-pub(super) fn unit(r: &mut Xoshiro256PlusPlus) -> DVec3 {
+pub(crate) fn unit(r: &mut Xoshiro256PlusPlus) -> DVec3 {
     loop {
         let v = DVec3::new(
             r.random::<f64>() * 2.0 - 1.0,
@@ -28,7 +28,7 @@ pub(super) fn unit(r: &mut Xoshiro256PlusPlus) -> DVec3 {
     }
 }
 
-pub(super) fn quat(r: &mut Xoshiro256PlusPlus) -> DQuat {
+pub(crate) fn quat(r: &mut Xoshiro256PlusPlus) -> DQuat {
     loop {
         let v = [0; 4].map(|_| r.random::<f64>() * 2.0 - 1.0);
         let q = DQuat::from_xyzw(v[0], v[1], v[2], v[3]);
