@@ -204,13 +204,18 @@ pub fn overlap_upper_bound(
     let (qa, qb) = (qa.normalize(), qb.normalize());
     // u in a's body frame and in the lab: from the warm point the body-frame normal needs no
     // rotation there and back
-    let from_warm = warm
-        .filter(|w| w.s_a.is_finite())
-        .and_then(|w| a.prepared.eval(w.s_a).grad.try_normalize())
-        .map(|ua| (ua, qa * ua));
-    let Some((ua, u)) = from_warm.or_else(|| d.try_normalize().map(|u| (qa.conjugate() * u, u)))
-    else {
-        return f64::INFINITY;
+    // (a match, not `Option::or_else`: the compiler kept that a call, with the pair's
+    // vectors passed through memory, on the path of every bound)
+    let from_warm = match warm {
+        Some(w) if w.s_a.is_finite() => a.prepared.eval(w.s_a).grad.try_normalize(),
+        _ => None,
+    };
+    let (ua, u) = match from_warm {
+        Some(ua) => (ua, qa * ua),
+        None => match d.try_normalize() {
+            Some(u) => (qa.conjugate() * u, u),
+            None => return f64::INFINITY,
+        },
     };
     let ub = qb.conjugate() * -u;
     let bound = a.prepared.support_value(ua) + b.prepared.support_value(ub) - d.dot(u);
