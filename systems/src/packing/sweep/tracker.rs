@@ -28,8 +28,9 @@ pub struct OverlapTracker {
     above: Vec<u32>,
     /// The tolerance of the last scan.
     tol: f64,
-    /// Scratch: pair marks (all false between scans) and selected pairs.
-    pair_mark: Vec<bool>,
+    /// Scratch: pair marks, one bit per pair of [`NeighbourList::unique`] (all zero between
+    /// scans), and selected pairs.
+    pair_mark: Vec<u64>,
     selected: Vec<u32>,
     /// Moves of each particle since the last full scan (the contact cache's clock).
     version: Vec<u32>,
@@ -190,7 +191,7 @@ impl OverlapTracker {
             self.above.clear();
             self.above.resize(n, 0);
             self.pair_mark.clear();
-            self.pair_mark.resize(npairs, false);
+            self.pair_mark.resize(npairs.div_ceil(64), 0);
             self.wall.clear();
             self.wall.resize(n, false);
             self.version.clear();
@@ -204,16 +205,20 @@ impl OverlapTracker {
             self.selected.extend(0..npairs as u32);
         } else {
             // the pairs of the moved particles, each once and in pair order (a pass over the
-            // marks is cheaper than sorting them; marks cleared again)
+            // marks' words is cheaper than sorting them, and than a pass over one flag per
+            // pair, which was most of the scan's serial time; marks cleared again)
             for &i in &self.moved {
                 let first = list.entry_start(i as usize);
                 for k in first..first + list.of(i as usize).len() {
-                    self.pair_mark[list.pair_of_entry(k)] = true;
+                    let p = list.pair_of_entry(k);
+                    self.pair_mark[p / 64] |= 1 << (p % 64);
                 }
             }
-            for (p, mark) in self.pair_mark.iter_mut().enumerate() {
-                if std::mem::take(mark) {
-                    self.selected.push(p as u32);
+            for (w, word) in self.pair_mark.iter_mut().enumerate() {
+                let mut bits = std::mem::take(word);
+                while bits != 0 {
+                    self.selected.push((w * 64) as u32 + bits.trailing_zeros());
+                    bits &= bits - 1;
                 }
             }
         }

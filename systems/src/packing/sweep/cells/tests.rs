@@ -40,7 +40,8 @@ fn reference_sweep(
     let mut count = SweepCount::default();
     let mut scratch = Vec::new();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(0);
-    for queues in cells.queues(state, order) {
+    let all = cells.queues(state, order);
+    for queues in all.colours() {
         let mut pos = vec![0usize; queues.len()];
         loop {
             let live: Vec<usize> = (0..queues.len())
@@ -209,7 +210,8 @@ fn cells_joined_by_listed_pairs_run_one_after_the_other() {
     list.ensure(&mut state.clone());
     let cells = slabs(&state, &list);
     let all: Vec<usize> = (0..state.len()).collect();
-    let queues = &cells.queues(&state, &all)[0];
+    let first = cells.queues(&state, &all);
+    let queues = &first.colours().next().unwrap();
     let mut marks = Marks {
         cell: vec![NONE; state.len()],
         slot: vec![NONE; state.len()],
@@ -231,8 +233,14 @@ fn queues_hold_every_particle_once_in_cells_a_width_apart() {
     assert!(per_colour >= MIN_CELLS_PER_COLOUR.min(4), "{cells:?}");
     let mut order: Vec<usize> = (0..state.len()).collect();
     order.shuffle(&mut Xoshiro256PlusPlus::seed_from_u64(2));
-    let queues = cells.queues(&state, &order);
-    let mut seen: Vec<usize> = queues.iter().flatten().flatten().copied().collect();
+    let all = cells.queues(&state, &order);
+    let queues: Vec<Vec<&[usize]>> = all.colours().collect();
+    let mut seen: Vec<usize> = queues
+        .iter()
+        .flatten()
+        .flat_map(|q| q.iter())
+        .copied()
+        .collect();
     seen.sort_unstable();
     assert_eq!(seen, (0..state.len()).collect::<Vec<_>>());
     let width = list.centre_range() + list.skin;
@@ -243,8 +251,8 @@ fn queues_hold_every_particle_once_in_cells_a_width_apart() {
             let rank = |i: &usize| order.iter().position(|o| o == i);
             assert!(qa.windows(2).all(|w| rank(&w[0]) < rank(&w[1])));
             for qb in &colour[a + 1..] {
-                for &i in qa {
-                    for &j in qb {
+                for &i in qa.iter() {
+                    for &j in qb.iter() {
                         let (xi, xj) = (state.positions[i], state.positions[j]);
                         let far = split.iter().any(|&ax| {
                             let l = state.edges[ax];
