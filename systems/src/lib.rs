@@ -14,12 +14,14 @@
 //! * [`packing`]: the mechanical contraction method.
 //! * [`analysis`]: contact numbers and order parameters.
 //! * [`rng`]: per-particle random streams.
+//! * [`buckets`]: the stable counting sort of the cell lists.
 //! * [`par`]: per-entity loops that go parallel only with enough entities.
 
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod brownian;
+pub mod buckets;
 pub mod clock;
 pub mod collision;
 pub mod field;

@@ -19,6 +19,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::domain::CollisionDomain;
+use crate::buckets::bucket_sort;
 
 /// Per-particle sorted candidate lists (compressed rows) and the grid scratch.
 #[derive(Debug, Clone, Default)]
@@ -158,21 +159,12 @@ impl Candidates {
             let w = domain.wrap(*p);
             cell_id(std::array::from_fn(|k| axes[k].index(w[k])))
         }));
-        self.cell_start.clear();
-        self.cell_start.resize(n_cells + 1, 0);
-        for &c in &self.cell_of {
-            self.cell_start[c + 1] += 1;
-        }
-        for c in 0..n_cells {
-            self.cell_start[c + 1] += self.cell_start[c];
-        }
-        self.cell_items.clear();
-        self.cell_items.resize(n, 0);
-        let mut fill = self.cell_start.clone();
-        for (i, &c) in self.cell_of.iter().enumerate() {
-            self.cell_items[fill[c]] = i as u32;
-            fill[c] += 1;
-        }
+        bucket_sort(
+            &self.cell_of,
+            n_cells,
+            &mut self.cell_start,
+            &mut self.cell_items,
+        );
 
         self.offsets.clear();
         self.offsets.push(0);

@@ -39,6 +39,7 @@ use glam::{DQuat, DVec3};
 use rand::{Rng, RngExt};
 
 use super::{OverlapTracker, Proposal, SweepCount, commit_counted, contacts_with, unused_rng};
+use crate::buckets::bucket_sort;
 use crate::packing::moves::{MoveRule, overlap_removal_move};
 use crate::packing::neighbour::NeighbourList;
 use crate::packing::state::PackingState;
@@ -139,25 +140,18 @@ impl SweepCells {
         // vector, then the non-empty cells of each colour in index order: a few vectors per
         // sweep instead of one per cell (those were a fifth of the serial time on two threads)
         let ncells = self.n.iter().product::<usize>();
-        let located: Vec<(u32, u32)> = order
-            .iter()
-            .map(|&i| self.locate(state.positions[i]))
-            .collect();
-        let mut start = vec![0usize; ncells + 1];
         let mut colour_of = vec![0u8; ncells];
-        for &(colour, cell) in &located {
-            start[cell as usize + 1] += 1;
-            colour_of[cell as usize] = colour as u8;
-        }
-        for c in 0..ncells {
-            start[c + 1] += start[c];
-        }
-        let mut particles = vec![0usize; order.len()];
-        let mut next = start.clone();
-        for (&i, &(_, cell)) in order.iter().zip(&located) {
-            particles[next[cell as usize]] = i;
-            next[cell as usize] += 1;
-        }
+        let cell_of: Vec<usize> = order
+            .iter()
+            .map(|&i| {
+                let (colour, cell) = self.locate(state.positions[i]);
+                colour_of[cell as usize] = colour as u8;
+                cell as usize
+            })
+            .collect();
+        let (mut start, mut slots) = (Vec::new(), Vec::new());
+        bucket_sort(&cell_of, ncells, &mut start, &mut slots);
+        let particles = slots.iter().map(|&k| order[k as usize]).collect();
         let mut colours: Vec<Vec<(usize, usize)>> = vec![Vec::new(); 8];
         for c in 0..ncells {
             if start[c + 1] > start[c] {
